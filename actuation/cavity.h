@@ -1,0 +1,61 @@
+// Closed cavity (bladder) loaded by a prescribed pressure p(t) [Pa] as a follower
+// load: the energy is the negative pressure work  E = - p V(x),  V the enclosed
+// volume [m^3] computed from the cavity's wall faces by the divergence theorem:
+//
+//   V = -(1/|S|) sum_faces int_face (S x) . n dA,   S = diag(s_x, s_y, s_z), s in {0,1}
+//
+// where n is the wall's normal pointing out of the solid (into the cavity) and
+// |S| = s_x + s_y + s_z. With S = I the wall must be closed. A cavity cut by
+// symmetry planes or plane-strain end caps uses only the axes whose coordinate
+// vanishes (times n) on the missing faces, e.g. S = diag(1,1,0) for a quarter
+// cylinder with caps z = const: the missing faces then contribute nothing and V
+// is exact. The Hessian of -pV is the load stiffness; p > 0 inflates.
+#pragma once
+#include <array>
+#include <string>
+#include <vector>
+
+#include "fem/assembly.h"
+#include "fem/element.h"
+#include "fem/energy.h"
+#include "fem/time_function.h"
+
+namespace morphfem {
+
+struct CavitySpec {
+  std::string name;
+  std::vector<std::string> surfaces;       // wall surface regions
+  std::array<bool, 3> axes{true, true, true};  // S: which coordinates enter V
+  TimeFunction pressure;                  // p(t) [Pa], gauge
+};
+
+// Kernel for one wall face (n nodes): f = int (S x).(a x b) dxi deta with
+// a = dx/dxi, b = dx/deta; gradient and Hessian w.r.t. nodal positions (3n).
+// Exposed for the finite-difference tests.
+double cavity_face_integral(const ShapeTable& table, const std::array<bool, 3>& axes,
+                            const Eigen::MatrixXd& x, Eigen::VectorXd* g, Eigen::MatrixXd* H);
+
+class CavityPressureTerm : public EnergyTerm {
+ public:
+  CavityPressureTerm(const Mesh& mesh, const Partition& partition, int rank, CavitySpec spec);
+  std::string name() const override { return "cavity:" + spec_.name; }
+  int n_pieces() const override { return static_cast<int>(faces_.size()); }
+  void piece_nodes(int k, std::vector<int>& nodes) const override;
+  double piece(int k, const PieceState& s, Eigen::VectorXd* g, Eigen::MatrixXd* H) const override;
+  void set_time(double t) override { pressure_ = spec_.pressure(t); }
+
+  double pressure() const { return pressure_; }
+  const CavitySpec& spec() const { return spec_; }
+  // Enclosed volume [m^3] at displacement u (collective). V at u = 0 is the
+  // reference volume.
+  double volume(Assembler& assembler, Vec u) const;
+
+ private:
+  const Mesh& mesh_;
+  CavitySpec spec_;
+  std::vector<int> faces_;
+  ShapeTable table_;
+  double pressure_ = 0.0;
+};
+
+}  // namespace morphfem

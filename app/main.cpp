@@ -1,0 +1,147 @@
+// morphfem: finite elements for shape-changing pneumatic soft robots.
+//
+//   morphfem run SCENE.yaml [PETSc options]       simulate a scene
+//   morphfem verify [--case NAME]... [--quick] [--json] [--out DIR]
+//   morphfem fit-materials [--data-dir DIR] [--max-strain S] [--json]
+//   morphfem hw emulate|play|check ...            regulators (hardware/README.md)
+//
+// PETSc options (-snes_monitor, -ksp_type, -pc_type, ...) pass through.
+#include <petscsys.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include "app/scene.h"
+#include "app/simulation.h"
+#include "app/verify.h"
+#include "core/errors.h"
+#include "core/json.h"
+#include "fem/material_fit.h"
+#include "hardware/cli.h"
+
+namespace {
+
+const char* kUsage =
+    "usage: morphfem <command> [arguments] [PETSc options]\n"
+    "commands:\n"
+    "  run SCENE.yaml               simulate a scene; results to the scene's output.directory\n"
+    "  verify [--case NAME]... [--quick] [--json] [--out DIR]\n"
+    "                               verification cases (patch, mms, cylinder, cantilever) with\n"
+    "                               error against the reference beside wall time\n"
+    "  fit-materials [--data-dir DIR] [--max-strain S] [--json]\n"
+    "                               fit hyperelastic laws to uniaxial test exports\n"
+    "  hw emulate|play|check ...    pneumatic regulators (see hardware/README.md)\n";
+
+int rank_of_world() {
+  int rank = 0;
+  MPI_Comm_rank(PETSC_COMM_WORLD, &rank);
+  return rank;
+}
+
+int cmd_run(const std::vector<std::string>& args) {
+  std::string path;
+  for (const auto& a : args)
+    if (!a.empty() && a[0] != '-' && path.empty()) path = a;
+  if (path.empty()) throw morphfem::InputError("morphfem run", "missing the scene file (morphfem run SCENE.yaml)");
+  morphfem::Scene scene = morphfem::read_scene(path);
+  auto result = morphfem::run_scene(scene, PETSC_COMM_WORLD);
+  if (rank_of_world() == 0) {
+    std::printf("%s: %s, %ld dofs, %d steps, %d Newton iterations, %d step cuts, %.2f s",
+                scene.name.c_str(), result.stats.completed ? "completed" : "FAILED", result.dofs, result.stats.steps,
+                result.stats.newton_its, result.stats.step_cuts, result.stats.wall_s);
+    for (size_t i = 0; i < result.cavity_names.size(); ++i)
+      std::printf(", cavity %s: p = %.4g Pa, V = %.4g m^3", result.cavity_names[i].c_str(), result.cavity_pressure[i],
+                  result.cavity_volume[i]);
+    std::printf("\n");
+    if (!result.output_dir.empty())
+      std::printf("results: %s/%s.xdmf (open in ParaView), %s/summary.json\n", result.output_dir.c_str(),
+                  scene.name.c_str(), result.output_dir.c_str());
+    if (!result.stats.completed) std::fprintf(stderr, "morphfem: solve failed: %s\n", result.stats.failure.c_str());
+  }
+  return result.stats.completed ? 0 : 3;
+}
+
+void print_table(const std::vector<morphfem::VerificationRecord>& records) {
+  std::printf("%-11s %-36s %3s %2s %9s %8s %12s %12s %9s %6s %8s %6s\n", "case", "quantity", "lvl", "P", "h [m]", "dofs",
+              "value", "reference", "rel_err", "rate", "wall_s", "newton");
+  for (const auto& r : records)
+    std::printf("%-11s %-36s %3d %2d %9.3g %8ld %12.6g %12.6g %9.2e %6s %8.2f %6d\n", r.case_name.c_str(),
+                r.quantity.c_str(), r.level, r.order, r.h, r.dofs, r.value, r.reference, r.rel_error,
+                r.rate != 0 ? std::to_string(r.rate).substr(0, 5).c_str() : "-", r.wall_s, r.newton_its);
+}
+
+int cmd_verify(const std::vector<std::string>& args) {
+  morphfem::VerifyOptions options;
+  bool json = false;
+  std::string out_dir = "results/verify";
+  for (size_t i = 0; i < args.size(); ++i) {
+    if (args[i] == "--case" && i + 1 < args.size()) options.cases.push_back(args[++i]);
+    else if (args[i] == "--quick") options.quick = true;
+    else if (args[i] == "--json") json = true;
+    else if (args[i] == "--out" && i + 1 < args.size()) out_dir = args[++i];
+    else if (args[i].rfind("--", 0) == 0) throw morphfem::InputError("morphfem verify", "unknown option " + args[i]);
+  }
+  options.progress = !json;
+  auto records = morphfem::run_verification(options, PETSC_COMM_WORLD);
+  if (rank_of_world() != 0) return 0;
+  std::string lines;
+  for (const auto& r : records) lines += r.json() + "\n";
+  if (json) std::fputs(lines.c_str(), stdout);
+  else print_table(records);
+  std::filesystem::create_directories(out_dir);
+  const std::string jsonl = out_dir + "/verification.jsonl";
+  morphfem::write_file_atomic(jsonl, lines);
+  const std::string script = std::string(MORPHFEM_SOURCE_DIR) + "/scripts/plot_verification.py";
+  if (std::filesystem::exists("/usr/bin/python3") && std::filesystem::exists(script)) {
+    const std::string cmd = "/usr/bin/python3 '" + script + "' '" + jsonl + "' '" + out_dir + "' >&2";
+    if (std::system(cmd.c_str()) != 0) std::fprintf(stderr, "morphfem: plotting failed (results are in %s)\n", jsonl.c_str());
+  }
+  if (!json) std::printf("records: %s; plots: %s/*.png\n", jsonl.c_str(), out_dir.c_str());
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::vector<std::string> args(argv + 1, argv + argc);
+  if (args.empty() || args[0] == "--help" || args[0] == "-h" || args[0] == "help") {
+    std::fputs(kUsage, args.empty() ? stderr : stdout);
+    return args.empty() ? 2 : 0;
+  }
+  const std::string command = args[0];
+  std::vector<std::string> rest(args.begin() + 1, args.end());
+  // Commands that need neither MPI nor PETSc.
+  try {
+    if (command == "hw") return morphfem::hardware_main(rest);
+    if (command == "fit-materials")
+      return morphfem::fit_materials_main(rest, std::string(MORPHFEM_SOURCE_DIR) + "/../shared/data/materials");
+  } catch (const morphfem::InputError& e) {
+    std::fprintf(stderr, "morphfem: error: %s\n", e.what());
+    return 2;
+  }
+  if (command != "run" && command != "verify") {
+    std::fprintf(stderr, "morphfem: unknown command '%s'\n%s", command.c_str(), kUsage);
+    return 2;
+  }
+  if (PetscInitialize(&argc, &argv, nullptr, nullptr)) return 1;
+  int status = 0;
+  try {
+    status = command == "run" ? cmd_run(rest) : cmd_verify(rest);
+  } catch (const morphfem::InputError& e) {
+    if (rank_of_world() == 0) std::fprintf(stderr, "morphfem: error: %s\n", e.what());
+    status = 2;
+  } catch (const morphfem::SolveError& e) {
+    if (rank_of_world() == 0) std::fprintf(stderr, "morphfem: solve failed: %s\n", e.what());
+    status = 3;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "morphfem: internal error: %s\n", e.what());
+    status = 4;
+  }
+  PetscFinalize();
+  return status;
+}

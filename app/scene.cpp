@@ -1,0 +1,252 @@
+#include "app/scene.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <filesystem>
+#include <set>
+
+#include "core/errors.h"
+
+namespace morphfem {
+
+namespace {
+
+struct Reader {
+  std::string file;
+
+  std::string at(const YAML::Node& node) const {
+    const YAML::Mark m = node.Mark();
+    if (m.line < 0) return file;
+    return file + ":" + std::to_string(m.line + 1) + ":" + std::to_string(m.column + 1);
+  }
+  [[noreturn]] void fail(const YAML::Node& node, const std::string& key, const std::string& what) const {
+    throw InputError(at(node), (key.empty() ? "" : "'" + key + "': ") + what);
+  }
+  void allow(const YAML::Node& map, const std::string& key, const std::set<std::string>& allowed) const {
+    if (!map.IsMap()) fail(map, key, "expected a mapping of keys to values");
+    for (const auto& kv : map) {
+      const std::string k = kv.first.as<std::string>();
+      if (!allowed.count(k)) {
+        std::string list;
+        for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
+        fail(kv.first, key.empty() ? k : key + "." + k, "unknown key (allowed: " + list + ")");
+      }
+    }
+  }
+  double number(const YAML::Node& node, const std::string& key) const {
+    if (!node.IsScalar()) fail(node, key, "expected a number");
+    try {
+      return node.as<double>();
+    } catch (const YAML::Exception&) {
+      fail(node, key, "expected a number, got '" + node.Scalar() + "'");
+    }
+  }
+  Eigen::Vector3d vector3(const YAML::Node& node, const std::string& key) const {
+    if (!node.IsSequence() || node.size() != 3) fail(node, key, "expected a list of 3 numbers [x, y, z]");
+    return {number(node[0], key), number(node[1], key), number(node[2], key)};
+  }
+  std::string text(const YAML::Node& node, const std::string& key) const {
+    if (!node.IsScalar()) fail(node, key, "expected text");
+    return node.Scalar();
+  }
+  std::vector<std::string> texts(const YAML::Node& node, const std::string& key) const {
+    if (node.IsScalar()) return {node.Scalar()};
+    if (!node.IsSequence()) fail(node, key, "expected a name or a list of names");
+    std::vector<std::string> out;
+    for (const auto& n : node) out.push_back(text(n, key));
+    return out;
+  }
+  std::array<bool, 3> axes(const YAML::Node& node, const std::string& key) const {
+    std::array<bool, 3> out{false, false, false};
+    for (const auto& name : texts(node, key)) {
+      if (name == "x") out[0] = true;
+      else if (name == "y") out[1] = true;
+      else if (name == "z") out[2] = true;
+      else fail(node, key, "unknown axis '" + name + "' (allowed: x, y, z)");
+    }
+    return out;
+  }
+  // A map of scalars and numeric lists -> ParamSet (each value remembers its line).
+  ParamSet params(const YAML::Node& map, const std::string& context) const {
+    if (!map.IsMap()) fail(map, context, "expected a mapping of parameters");
+    ParamSet p(context);
+    for (const auto& kv : map) {
+      const std::string k = kv.first.as<std::string>();
+      const YAML::Node& v = kv.second;
+      if (v.IsSequence()) {
+        std::vector<double> values;
+        for (const auto& item : v) values.push_back(number(item, context + "." + k));
+        p.set(k, values, at(v));
+      } else if (v.IsScalar()) {
+        double d;
+        if (YAML::convert<double>::decode(v, d)) p.set(k, d, at(v));
+        else p.set_string(k, v.Scalar(), at(v));
+      } else {
+        fail(v, context + "." + k, "expected a number, a list of numbers or text");
+      }
+    }
+    return p;
+  }
+  // A load magnitude over time: a number (ramped from 0 over [0, end]) or a table.
+  TimeFunction ramp_or_table(const YAML::Node& node, const std::string& key, double end_time) const {
+    if (node.IsScalar()) return TimeFunction::ramp(number(node, key), end_time);
+    if (!node.IsSequence() || node.size() == 0) fail(node, key, "expected a number or a table [[t, value], ...]");
+    std::vector<std::pair<double, double>> points;
+    for (const auto& row : node) {
+      if (!row.IsSequence() || row.size() != 2) fail(row, key, "each table row must be [time, value]");
+      points.emplace_back(number(row[0], key), number(row[1], key));
+      if (points.size() > 1 && !(points.back().first > points[points.size() - 2].first))
+        fail(row, key, "table times must increase strictly");
+    }
+    return TimeFunction(points);
+  }
+};
+
+}  // namespace
+
+Scene read_scene(const std::string& path) {
+  if (!std::filesystem::exists(path)) throw InputError(path, "scene file not found");
+  Reader r{path};
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(path);
+  } catch (const YAML::ParserException& e) {
+    throw InputError(path + ":" + std::to_string(e.mark.line + 1) + ":" + std::to_string(e.mark.column + 1),
+                     "YAML syntax error: " + e.msg);
+  }
+  if (!root.IsMap()) throw InputError(path, "a scene must be a mapping with keys geometry/mesh, materials, ...");
+  r.allow(root, "", {"name", "geometry", "mesh", "materials", "boundary", "loads", "solver", "output"});
+  Scene scene;
+  scene.source = path;
+  if (root["name"]) scene.name = r.text(root["name"], "name");
+
+  // Solver first: load ramps need end_time.
+  if (const auto s = root["solver"]) {
+    r.allow(s, "solver", {"end_time", "initial_step", "min_step", "max_step", "linear_solver",
+                          "quadrature_degree", "max_newton_its", "rtol"});
+    auto positive = [&](const char* key, double& out) {
+      if (s[key]) {
+        out = r.number(s[key], std::string("solver.") + key);
+        if (!(out > 0)) r.fail(s[key], std::string("solver.") + key, "must be positive");
+      }
+    };
+    positive("end_time", scene.solver.t_end);
+    positive("initial_step", scene.solver.dt_initial);
+    positive("min_step", scene.solver.dt_min);
+    positive("max_step", scene.solver.dt_max);
+    positive("rtol", scene.solver.rtol);
+    if (s["linear_solver"]) {
+      scene.solver.linear_solver = r.text(s["linear_solver"], "solver.linear_solver");
+      if (scene.solver.linear_solver != "mumps" && scene.solver.linear_solver != "gamg")
+        r.fail(s["linear_solver"], "solver.linear_solver", "must be 'mumps' or 'gamg'");
+    }
+    if (s["quadrature_degree"]) {
+      double q = r.number(s["quadrature_degree"], "solver.quadrature_degree");
+      if (q < 0 || q > 6 || q != int(q)) r.fail(s["quadrature_degree"], "solver.quadrature_degree", "must be 0..6");
+      scene.quadrature_degree = int(q);
+    }
+    if (s["max_newton_its"]) {
+      double q = r.number(s["max_newton_its"], "solver.max_newton_its");
+      if (q < 1 || q != int(q)) r.fail(s["max_newton_its"], "solver.max_newton_its", "must be a positive integer");
+      scene.solver.max_newton_its = int(q);
+    }
+  } else {
+    scene.solver.t_end = 1.0;
+  }
+  scene.solver.dt_initial = std::min(scene.solver.dt_initial, scene.solver.t_end);
+  scene.solver.dt_max = std::min(scene.solver.dt_max, scene.solver.t_end);
+  const double end = scene.solver.t_end;
+
+  if (root["geometry"] && root["mesh"]) r.fail(root["mesh"], "mesh", "give either geometry or mesh, not both");
+  if (const auto g = root["geometry"]) {
+    scene.geometry = r.params(g, "geometry");
+    if (!scene.geometry.has("type")) r.fail(g, "geometry", "missing key 'type'");
+  } else if (const auto m = root["mesh"]) {
+    r.allow(m, "mesh", {"file"});
+    if (!m["file"]) r.fail(m, "mesh", "missing key 'file'");
+    std::filesystem::path file = r.text(m["file"], "mesh.file");
+    if (file.is_relative()) file = std::filesystem::path(path).parent_path() / file;
+    scene.mesh_file = file.string();
+  } else {
+    throw InputError(path, "missing 'geometry' or 'mesh'");
+  }
+
+  const auto materials = root["materials"];
+  if (!materials || !materials.IsMap() || materials.size() == 0)
+    throw InputError(materials ? r.at(materials) : path, "'materials' must map each volume region to a material");
+  for (const auto& kv : materials) {
+    const std::string region = kv.first.as<std::string>();
+    ParamSet p = r.params(kv.second, "materials." + region);
+    if (!p.has("model")) r.fail(kv.second, "materials." + region, "missing key 'model'");
+    scene.materials[region] = p;
+  }
+
+  if (const auto b = root["boundary"]) {
+    if (!b.IsSequence()) r.fail(b, "boundary", "expected a list of {surface, fix | displacement}");
+    for (const auto& item : b) {
+      r.allow(item, "boundary", {"surface", "fix", "displacement"});
+      if (!item["surface"]) r.fail(item, "boundary", "missing key 'surface'");
+      BoundarySpec spec;
+      spec.surface = r.text(item["surface"], "boundary.surface");
+      spec.where = r.at(item);
+      if (item["fix"] && item["displacement"]) r.fail(item, "boundary", "give either 'fix' or 'displacement'");
+      if (item["fix"]) spec.components = r.axes(item["fix"], "boundary.fix");
+      else if (item["displacement"]) {
+        spec.components = {true, true, true};
+        spec.displacement = r.vector3(item["displacement"], "boundary.displacement");
+      } else {
+        r.fail(item, "boundary", "missing 'fix: [x, y, z]' or 'displacement: [ux, uy, uz]'");
+      }
+      scene.boundary.push_back(spec);
+    }
+  }
+
+  if (const auto l = root["loads"]) {
+    r.allow(l, "loads", {"gravity", "cavities", "tractions"});
+    if (l["gravity"]) scene.gravity = r.vector3(l["gravity"], "loads.gravity");
+    if (const auto cs = l["cavities"]) {
+      if (!cs.IsSequence()) r.fail(cs, "loads.cavities", "expected a list");
+      for (const auto& c : cs) {
+        r.allow(c, "loads.cavities", {"name", "surfaces", "volume_axes", "pressure"});
+        CavitySpec spec;
+        if (!c["surfaces"]) r.fail(c, "loads.cavities", "missing key 'surfaces'");
+        if (!c["pressure"]) r.fail(c, "loads.cavities", "missing key 'pressure'");
+        spec.name = c["name"] ? r.text(c["name"], "loads.cavities.name") : "cavity" + std::to_string(scene.cavities.size());
+        spec.surfaces = r.texts(c["surfaces"], "loads.cavities.surfaces");
+        if (c["volume_axes"]) spec.axes = r.axes(c["volume_axes"], "loads.cavities.volume_axes");
+        spec.pressure = r.ramp_or_table(c["pressure"], "loads.cavities.pressure", end);
+        scene.cavities.push_back(spec);
+      }
+    }
+    if (const auto ts = l["tractions"]) {
+      if (!ts.IsSequence()) r.fail(ts, "loads.tractions", "expected a list");
+      for (const auto& t : ts) {
+        r.allow(t, "loads.tractions", {"surface", "traction", "scale"});
+        TractionSpec spec;
+        if (!t["surface"] || !t["traction"]) r.fail(t, "loads.tractions", "needs 'surface' and 'traction'");
+        spec.surface = r.text(t["surface"], "loads.tractions.surface");
+        spec.traction = r.vector3(t["traction"], "loads.tractions.traction");
+        spec.scale = t["scale"] ? r.ramp_or_table(t["scale"], "loads.tractions.scale", end)
+                                : TimeFunction::ramp(1.0, end);
+        spec.where = r.at(t);
+        scene.tractions.push_back(spec);
+      }
+    }
+  }
+
+  if (const auto o = root["output"]) {
+    r.allow(o, "output", {"directory", "every"});
+    if (o["directory"]) {
+      std::filesystem::path dir = r.text(o["directory"], "output.directory");
+      scene.output_dir = dir.string();
+    }
+    if (o["every"]) {
+      double every = r.number(o["every"], "output.every");
+      if (every < 1 || every != int(every)) r.fail(o["every"], "output.every", "must be a positive integer");
+      scene.output_every = int(every);
+    }
+  }
+  return scene;
+}
+
+}  // namespace morphfem

@@ -1,0 +1,78 @@
+// Scenes: what to simulate, read from YAML or built in code (verification cases
+// build the same struct). A scene declares only the physics it needs; the
+// simulation builds only those energy terms.
+//
+// YAML layout (every key is checked; unknown keys are errors):
+//   name: demo
+//   geometry: {type: thick_cylinder, inner_radius: 0.01, ..., mesh_size: 0.002, order: 2}
+//   mesh: {file: body.msh}                      # instead of geometry
+//   materials:                                  # volume region -> law (fem/material.h)
+//     body: {model: neo_hookean, mu: 80e3, kappa: 80e6, density: 1070}
+//   boundary:                                   # surface region -> prescribed displacement
+//     - {surface: sym_x, fix: [x]}              # u_x = 0
+//     - {surface: top, displacement: [0, 0, -1e-3]}   # ramped linearly over the run
+//   loads:
+//     gravity: [0, 0, -9.81]                    # m/s^2, needs `density` [kg/m^3]
+//     cavities:
+//       - {name: core, surfaces: [inner], volume_axes: [x, y], pressure: 40e3}
+//         # pressure [Pa]: a number (ramped 0 -> value over the run) or a table
+//         # [[t0, p0], [t1, p1], ...] (piecewise linear, times in s)
+//     tractions:
+//       - {surface: tip, traction: [0, 0, -100]}  # dead load [Pa], ramped like pressure
+//   solver: {end_time: 1, initial_step: 0.1, min_step: 1e-6, max_step: 1,
+//            linear_solver: mumps|gamg, quadrature_degree: 0, max_newton_its: 30}
+//   output: {directory: results/demo, every: 1}
+#pragma once
+#include <array>
+#include <functional>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "actuation/cavity.h"
+#include "core/params.h"
+#include "fem/solver.h"
+
+namespace morphfem {
+
+struct BoundarySpec {
+  std::string surface;
+  std::array<bool, 3> components{false, false, false};
+  Eigen::Vector3d displacement = Eigen::Vector3d::Zero();  // final value [m], ramped
+  std::string where;
+  // Code-built scenes only: u(X, t) [m] instead of the ramped constant.
+  std::function<Eigen::Vector3d(const Eigen::Vector3d& X, double t)> field;
+};
+
+struct TractionSpec {
+  std::string surface;
+  Eigen::Vector3d traction = Eigen::Vector3d::Zero();  // [Pa]
+  TimeFunction scale;                                  // dimensionless factor of time
+  std::string where;
+};
+
+struct Scene {
+  std::string name = "scene";
+  std::string source;           // file the scene came from ("" if built in code)
+  ParamSet geometry;            // builder parameters (type, sizes, mesh_size, order)
+  std::string mesh_file;        // or a .msh file
+  std::map<std::string, ParamSet> materials;  // volume region -> law parameters
+  std::vector<BoundarySpec> boundary;
+  Eigen::Vector3d gravity = Eigen::Vector3d::Zero();
+  std::vector<CavitySpec> cavities;
+  std::vector<TractionSpec> tractions;
+  // Code-built scenes only: a body force b(X, t) [N/m^3] on every cell (e.g. a
+  // manufactured solution's load), integrated with `body_force_degree`.
+  std::function<Eigen::Vector3d(const Eigen::Vector3d& X, double t)> body_force;
+  int body_force_degree = 4;
+  SolverOptions solver;
+  int quadrature_degree = 0;
+  std::string output_dir;       // empty: no files
+  int output_every = 1;
+};
+
+// Reads and checks a scene file. Throws InputError("file:line:col", what) on the
+// first problem; nothing is created on disk.
+Scene read_scene(const std::string& path);
+
+}  // namespace morphfem

@@ -1,0 +1,301 @@
+#include "app/simulation.h"
+
+#include <mpi.h>
+
+#include <chrono>
+#include <filesystem>
+#include <limits>
+
+#include "actuation/cavity.h"
+#include "core/errors.h"
+#include "core/json.h"
+#include "core/progress.h"
+#include "fem/elastic.h"
+#include "fem/loads.h"
+#include "fem/material.h"
+#include "fem/output.h"
+#include "mesh/geometry.h"
+
+namespace morphfem {
+
+namespace {
+
+template <class Matrix>
+void bcast_matrix(Matrix& m, MPI_Datatype type, MPI_Comm comm) {
+  long dims[2] = {static_cast<long>(m.rows()), static_cast<long>(m.cols())};
+  MPI_Bcast(dims, 2, MPI_LONG, 0, comm);
+  m.resize(dims[0], dims[1]);
+  MPI_Bcast(m.data(), static_cast<int>(m.size()), type, 0, comm);
+}
+
+void bcast_ints(std::vector<int>& v, MPI_Comm comm) {
+  long n = static_cast<long>(v.size());
+  MPI_Bcast(&n, 1, MPI_LONG, 0, comm);
+  v.resize(n);
+  MPI_Bcast(v.data(), static_cast<int>(n), MPI_INT, 0, comm);
+}
+
+void bcast_string(std::string& s, MPI_Comm comm) {
+  long n = static_cast<long>(s.size());
+  MPI_Bcast(&n, 1, MPI_LONG, 0, comm);
+  s.resize(n);
+  MPI_Bcast(s.data(), static_cast<int>(n), MPI_CHAR, 0, comm);
+}
+
+// Rank 0 builds (gmsh is not run in parallel); everyone receives the same mesh.
+// An InputError on rank 0 is re-thrown on every rank.
+Mesh build_on_root(const Scene& scene, MPI_Comm comm) {
+  int rank;
+  MPI_Comm_rank(comm, &rank);
+  Mesh mesh;
+  std::string error, where;
+  if (rank == 0) {
+    try {
+      mesh = scene.mesh_file.empty() ? build_geometry(scene.geometry) : read_msh(scene.mesh_file);
+    } catch (const InputError& e) {
+      error = e.what();
+      where = e.where();
+    }
+  }
+  bcast_string(error, comm);
+  if (!error.empty()) {
+    bcast_string(where, comm);
+    // e.what() already includes `where`; keep the message as it is.
+    throw InputError("", error);
+  }
+  MPI_Bcast(&mesh.order, 1, MPI_INT, 0, comm);
+  bcast_matrix(mesh.X, MPI_DOUBLE, comm);
+  bcast_matrix(mesh.cells, MPI_INT, comm);
+  bcast_matrix(mesh.faces, MPI_INT, comm);
+  bcast_ints(mesh.cell_region, comm);
+  bcast_ints(mesh.face_region, comm);
+  long n_regions = static_cast<long>(mesh.regions.size());
+  MPI_Bcast(&n_regions, 1, MPI_LONG, 0, comm);
+  mesh.regions.resize(n_regions);
+  for (auto& region : mesh.regions) {
+    bcast_string(region.name, comm);
+    MPI_Bcast(&region.dim, 1, MPI_INT, 0, comm);
+    MPI_Bcast(&region.id, 1, MPI_INT, 0, comm);
+  }
+  return mesh;
+}
+
+std::string scene_key(const Scene& scene, const std::string& where, const std::string& key) {
+  if (!where.empty()) return where;
+  return (scene.source.empty() ? scene.name : scene.source) + ": " + key;
+}
+
+void require_surface(const Scene& scene, const Mesh& mesh, const std::string& name, const std::string& where,
+                     const std::string& key) {
+  if (!mesh.has_region(name, 2)) {
+    std::string known;
+    for (const auto& n : mesh.region_names(2)) known += (known.empty() ? "" : ", ") + n;
+    throw InputError(scene_key(scene, where, key), "the mesh has no surface region '" + name + "' (it has: " + known + ")");
+  }
+}
+
+}  // namespace
+
+Mesh build_scene_mesh(const Scene& scene, MPI_Comm comm) {
+  Mesh mesh = build_on_root(scene, comm);
+  const std::string src = scene.source.empty() ? scene.name : scene.source;
+  for (const auto& [region, params] : scene.materials)
+    if (!mesh.has_region(region, 3)) {
+      std::string known;
+      for (const auto& n : mesh.region_names(3)) known += (known.empty() ? "" : ", ") + n;
+      throw InputError(params.where("model"), "the mesh has no volume region '" + region + "' (it has: " + known + ")");
+    }
+  for (const auto& name : mesh.region_names(3))
+    if (!scene.materials.count(name)) throw InputError(src + ": materials", "no material for volume region '" + name + "'");
+  for (const auto& b : scene.boundary) require_surface(scene, mesh, b.surface, b.where, "boundary");
+  for (const auto& c : scene.cavities)
+    for (const auto& s : c.surfaces) require_surface(scene, mesh, s, "", "loads.cavities." + c.name);
+  for (const auto& t : scene.tractions) require_surface(scene, mesh, t.surface, t.where, "loads.tractions");
+  return mesh;
+}
+
+SimulationResult run_scene(const Scene& scene, MPI_Comm comm, const RunOptions& options) {
+  int rank, size;
+  MPI_Comm_rank(comm, &rank);
+  MPI_Comm_size(comm, &size);
+  auto start = std::chrono::steady_clock::now();
+
+  // ---- Everything that can be wrong with the input is checked before any output.
+  SimulationResult result;
+  result.mesh = build_scene_mesh(scene, comm);
+  Mesh& mesh = result.mesh;
+  std::vector<std::shared_ptr<const Material>> materials(mesh.regions.size());
+  std::vector<double> density(mesh.regions.size(), 0.0);
+  for (const auto& [region, params] : scene.materials) {
+    const int id = mesh.region(region, 3).id;
+    materials[id] = make_material(params.without("density"));
+    density[id] = params.number_in("density", 0.0, 1e5, 0.0);
+    if (scene.gravity.norm() > 0 && density[id] <= 0)
+      throw InputError(params.where("model"), "gravity is on but material '" + region + "' has no 'density' [kg/m^3]");
+  }
+  Partition partition = partition_mesh(mesh, size);
+
+  Assembler assembler(mesh, partition, comm);
+  auto elastic = std::make_shared<ElasticTerm>(mesh, partition, rank, materials, scene.quadrature_degree);
+  assembler.add_term(elastic);
+  if (scene.gravity.norm() > 0) {
+    // Gravity is a body force rho g [N/m^3]; rho depends on the cell's region, so
+    // one term per region keeps the kernel a pure function of X.
+    for (size_t id = 0; id < mesh.regions.size(); ++id) {
+      if (mesh.regions[id].dim != 3 || density[id] <= 0) continue;
+      const Eigen::Vector3d body = density[id] * scene.gravity;
+      assembler.add_term(std::make_shared<BodyForceTerm>(
+          mesh, partition, rank, mesh.cells_of(mesh.regions[id].name),
+          [body](const Eigen::Vector3d&, double) { return body; }, 2 * mesh.order));
+    }
+  }
+  if (scene.body_force) {
+    std::vector<int> all_cells(mesh.n_cells());
+    for (int c = 0; c < mesh.n_cells(); ++c) all_cells[c] = c;
+    assembler.add_term(std::make_shared<BodyForceTerm>(mesh, partition, rank, all_cells, scene.body_force,
+                                                       scene.body_force_degree));
+  }
+  std::vector<std::shared_ptr<CavityPressureTerm>> cavities;
+  for (const auto& spec : scene.cavities) {
+    cavities.push_back(std::make_shared<CavityPressureTerm>(mesh, partition, rank, spec));
+    assembler.add_term(cavities.back());
+  }
+  for (const auto& t : scene.tractions) {
+    const Eigen::Vector3d traction = t.traction;
+    const TimeFunction scale = t.scale;
+    assembler.add_term(std::make_shared<SurfaceLoadTerm>(
+        mesh, partition, rank, mesh.faces_of(t.surface),
+        [traction, scale](const Eigen::Vector3d&, double time) { return Eigen::Vector3d(scale(time) * traction); }));
+  }
+  std::vector<DirichletCondition> bcs;
+  const double t_end = scene.solver.t_end;
+  for (const auto& b : scene.boundary) {
+    DirichletCondition bc;
+    bc.name = b.surface;
+    bc.nodes = mesh.nodes_of_surface(b.surface);
+    bc.components = b.components;
+    const Eigen::Vector3d d = b.displacement;
+    if (b.field) bc.value = b.field;
+    else bc.value = [d, t_end](const Eigen::Vector3d&, double t) { return Eigen::Vector3d(d * std::min(1.0, t / t_end)); };
+    bcs.push_back(bc);
+  }
+  SolverOptions solver_options = scene.solver;
+  QuasiStaticSolver solver(assembler, bcs, solver_options);
+  result.dofs = assembler.n_dofs();
+  for (const auto& c : cavities) result.cavity_names.push_back(c->spec().name);
+
+  // ---- Output (rank 0 writes; every rank takes part in the gathers).
+  const bool write = options.write_output && !scene.output_dir.empty();
+  std::string tmp_dir;
+  std::unique_ptr<ResultWriter> writer;
+  if (write && rank == 0) {
+    tmp_dir = temporary_output_dir(scene.output_dir);
+    writer = std::make_unique<ResultWriter>(tmp_dir, scene.name, mesh);
+  }
+  std::vector<std::string> cavity_columns{"time"};
+  for (const auto& c : cavities) {
+    cavity_columns.push_back(c->spec().name + "_pressure_Pa");
+    cavity_columns.push_back(c->spec().name + "_volume_m3");
+  }
+  std::vector<std::string> energy_columns{"time"};
+  for (const auto& term : assembler.terms()) energy_columns.push_back(term->name() + "_J");
+
+  auto record = [&](double t, bool force_write, int step) {
+    result.u = assembler.gather_all(solver.solution());
+    result.cavity_pressure.clear();
+    result.cavity_volume.clear();
+    for (const auto& c : cavities) {
+      result.cavity_pressure.push_back(c->pressure());
+      result.cavity_volume.push_back(c->volume(assembler, solver.solution()));
+    }
+    // Cell measures: each rank fills its own cells, a reduction gathers them.
+    std::vector<double> J(mesh.n_cells(), 0.0), vm(mesh.n_cells(), 0.0), Jg(mesh.n_cells()), vmg(mesh.n_cells());
+    double local_min_J = std::numeric_limits<double>::infinity();
+    PieceState s;
+    std::vector<int> nodes;
+    for (int k = 0; k < elastic->n_pieces(); ++k) {
+      elastic->piece_nodes(k, nodes);
+      s.X.resize(nodes.size(), 3);
+      s.u.resize(nodes.size(), 3);
+      for (size_t a = 0; a < nodes.size(); ++a) {
+        s.X.row(a) = mesh.X.row(nodes[a]);
+        s.u.row(a) = result.u.row(nodes[a]);
+      }
+      auto m = elastic->measures(k, s);
+      J[elastic->cell_of_piece(k)] = m.J_mean;
+      vm[elastic->cell_of_piece(k)] = m.von_mises;
+      local_min_J = std::min(local_min_J, m.J_min);
+    }
+    MPI_Allreduce(&local_min_J, &result.min_J, 1, MPI_DOUBLE, MPI_MIN, comm);
+    const bool output_now = force_write || (step % scene.output_every == 0);
+    if (write && output_now) {
+      MPI_Reduce(J.data(), Jg.data(), mesh.n_cells(), MPI_DOUBLE, MPI_SUM, 0, comm);
+      MPI_Reduce(vm.data(), vmg.data(), mesh.n_cells(), MPI_DOUBLE, MPI_SUM, 0, comm);
+    }
+    std::vector<double> energies = assembler.term_energies(solver.solution());
+    if (writer && output_now) {
+      Field disp{"displacement", 3, std::vector<double>(result.u.data(), result.u.data() + result.u.size())};
+      writer->write_step(t, {disp}, {Field{"J", 1, Jg}, Field{"von_mises_Pa", 1, vmg}});
+      std::vector<double> row{t};
+      for (size_t i = 0; i < cavities.size(); ++i) {
+        row.push_back(result.cavity_pressure[i]);
+        row.push_back(result.cavity_volume[i]);
+      }
+      if (!cavities.empty()) writer->append_row("cavities", cavity_columns, row);
+      std::vector<double> erow{t};
+      erow.insert(erow.end(), energies.begin(), energies.end());
+      writer->append_row("energy", energy_columns, erow);
+    }
+    if (options.on_step) options.on_step(t, mesh, result.u, result);
+  };
+
+  Progress progress(scene.name, t_end, options.progress);
+  record(0.0, true, 0);
+  int last_written = 0;
+  result.stats = solver.run([&](const StepReport& r) {
+    const bool last = r.t >= t_end - 1e-12 * t_end;
+    record(r.t, last, r.step);
+    if (last || r.step % scene.output_every == 0) last_written = r.step;
+    progress.update(r.t, "step " + std::to_string(r.step) + " newton " + std::to_string(r.newton_its));
+  });
+  if (!result.stats.completed && last_written != result.stats.steps) record(solver.time(), true, result.stats.steps);
+  progress.finish(result.stats.completed ? "done" : "FAILED");
+  result.stats.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+
+  if (write) {
+    if (rank == 0) {
+      writer->close();
+      Json summary;
+      summary.add("scene", scene.name)
+          .add("status", result.stats.completed ? "completed" : "failed")
+          .add("failure", result.stats.failure)
+          .add("end_time_reached", solver.time())
+          .add("ranks", size)
+          .add("order", mesh.order)
+          .add("nodes", mesh.n_nodes())
+          .add("cells", mesh.n_cells())
+          .add("dofs", result.dofs)
+          .add("steps", result.stats.steps)
+          .add("newton_its", result.stats.newton_its)
+          .add("linear_its", result.stats.linear_its)
+          .add("step_cuts", result.stats.step_cuts)
+          .add("wall_s", result.stats.wall_s)
+          .add("min_J", result.min_J)
+          .add("max_displacement_m", result.u.rowwise().norm().maxCoeff());
+      std::vector<Json> cavs;
+      for (size_t i = 0; i < cavities.size(); ++i) {
+        Json c;
+        c.add("name", result.cavity_names[i]).add("pressure_Pa", result.cavity_pressure[i]).add("volume_m3", result.cavity_volume[i]);
+        cavs.push_back(c);
+      }
+      summary.add("cavities", cavs);
+      write_file_atomic(tmp_dir + "/summary.json", summary.str(true) + "\n");
+      commit_output_dir(tmp_dir, scene.output_dir);
+      result.output_dir = scene.output_dir;
+    }
+    bcast_string(result.output_dir, comm);
+  }
+  return result;
+}
+
+}  // namespace morphfem

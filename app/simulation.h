@@ -1,0 +1,45 @@
+// Runs a scene: builds the mesh and only the energy terms the scene declares,
+// solves in adaptive load steps, writes XDMF/HDF5 results and summary.json.
+#pragma once
+#include <functional>
+#include <memory>
+#include <string>
+
+#include "app/scene.h"
+#include "fem/assembly.h"
+#include "fem/solver.h"
+#include "mesh/mesh.h"
+#include "mesh/partition.h"
+
+namespace morphfem {
+
+struct SimulationResult {
+  Mesh mesh;              // as solved (nodes renumbered by the partitioner)
+  RowMatrixXd u;          // final displacement, n_nodes x 3 [m] (every rank)
+  RunStats stats;
+  long dofs = 0;
+  std::vector<std::string> cavity_names;
+  std::vector<double> cavity_pressure, cavity_volume;  // final [Pa], [m^3]
+  double min_J = 0;       // smallest det F over quadrature points at the end
+  std::string output_dir; // where results went ("" if none)
+};
+
+struct RunOptions {
+  bool write_output = true;  // honour scene.output_dir
+  bool progress = true;      // progress line with ETA on stderr (rank 0)
+  // Optional hook after each converged step (e.g. a verification case sampling a
+  // quantity along the load path): time, displacement (all nodes), cavity data.
+  std::function<void(double t, const Mesh&, const RowMatrixXd& u, const SimulationResult&)> on_step;
+};
+
+// Builds the mesh the scene asks for on rank 0 and broadcasts it; checks every
+// region name the scene uses. Throws InputError on bad input before any output
+// directory is created.
+Mesh build_scene_mesh(const Scene& scene, MPI_Comm comm);
+
+// Runs the scene. A solve that fails after all step cuts returns with
+// stats.completed == false and stats.failure set; the last converged state is
+// in `u` and in the output (written with status "failed").
+SimulationResult run_scene(const Scene& scene, MPI_Comm comm, const RunOptions& options = {});
+
+}  // namespace morphfem

@@ -1,0 +1,365 @@
+#include "app/verify.h"
+
+#include <chrono>
+#include <cmath>
+#include <functional>
+#include <map>
+#include <set>
+
+#include "app/simulation.h"
+#include "core/errors.h"
+#include "core/json.h"
+#include "fem/element.h"
+#include "fem/material.h"
+
+namespace morphfem {
+
+std::string VerificationRecord::json() const {
+  Json j;
+  j.add("case", case_name).add("quantity", quantity).add("level", level).add("order", order).add("h", h)
+      .add("value", value).add("reference", reference).add("rel_error", rel_error).add("rate", rate)
+      .add("dofs", dofs).add("wall_s", wall_s).add("newton_its", newton_its).add("steps", steps)
+      .add("step_cuts", step_cuts);
+  return j.str();
+}
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+ParamSet params(std::initializer_list<std::pair<const char*, double>> numbers, const char* type_key = nullptr,
+                const char* type = nullptr) {
+  ParamSet p("verification");
+  for (const auto& [k, v] : numbers) p.set(k, v);
+  if (type_key) p.set_string(type_key, type);
+  return p;
+}
+
+VerificationRecord record_of(const std::string& case_name, const std::string& quantity, int level, int order,
+                             double h, const SimulationResult& r) {
+  VerificationRecord rec;
+  rec.case_name = case_name;
+  rec.quantity = quantity;
+  rec.level = level;
+  rec.order = order;
+  rec.h = h;
+  rec.dofs = r.dofs;
+  rec.wall_s = r.stats.wall_s;
+  rec.newton_its = r.stats.newton_its;
+  rec.steps = r.stats.steps;
+  rec.step_cuts = r.stats.step_cuts;
+  return rec;
+}
+
+void check_completed(const SimulationResult& r, const std::string& what) {
+  if (!r.stats.completed) throw SolveError(what + ": " + r.stats.failure);
+}
+
+// Deformation gradient of the discrete field at reference point xi of cell c.
+Mat3 cell_F(const Mesh& mesh, const RowMatrixXd& u, int c, const Eigen::Vector3d& xi, Eigen::Matrix3d* grad_u = nullptr,
+            double* detJ0 = nullptr, Eigen::Vector3d* X_at = nullptr, Eigen::Vector3d* u_at = nullptr) {
+  Eigen::VectorXd N;
+  Eigen::MatrixXd dN;
+  tet_shape(mesh.order, xi, N, dN);
+  const int n = mesh.nodes_per_cell();
+  Eigen::MatrixXd X(n, 3), U(n, 3);
+  for (int a = 0; a < n; ++a) {
+    X.row(a) = mesh.X.row(mesh.cells(c, a));
+    U.row(a) = u.row(mesh.cells(c, a));
+  }
+  const Eigen::Matrix3d J0 = X.transpose() * dN;
+  const Eigen::MatrixXd dNdX = dN * J0.inverse();
+  const Eigen::Matrix3d G = U.transpose() * dNdX;
+  if (grad_u) *grad_u = G;
+  if (detJ0) *detJ0 = J0.determinant();
+  if (X_at) *X_at = X.transpose() * N;
+  if (u_at) *u_at = U.transpose() * N;
+  return Mat3::Identity() + G;
+}
+
+Scene base_scene(const std::string& name, ParamSet geometry, ParamSet material) {
+  Scene s;
+  s.name = name;
+  s.geometry = std::move(geometry);
+  s.materials["body"] = std::move(material);
+  return s;
+}
+
+// ---------------------------------------------------------------- case 1: patch test
+// Affine u = (F - I) X imposed on the whole boundary of a distorted block: the
+// discrete solution must be exactly affine (nodes and F in every cell).
+void patch_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<VerificationRecord>& out) {
+  Mat3 F;
+  F << 1.10, 0.05, 0.00, 0.02, 0.95, 0.03, 0.00, 0.04, 1.05;
+  const double L = 0.01;
+  std::vector<int> divisions = opt.quick ? std::vector<int>{2, 3} : std::vector<int>{2, 3, 4};
+  for (int order : {1, 2})
+    for (size_t level = 0; level < divisions.size(); ++level) {
+      const double h = L / divisions[level];
+      Scene s = base_scene("patch", params({{"lx", L}, {"ly", L}, {"lz", L}, {"mesh_size", h}, {"order", double(order)},
+                                            {"distort", 0.25}}, "type", "block"),
+                           params({{"mu", 1e5}, {"kappa", 5e5}}, "model", "neo_hookean"));
+      const Mat3 G = F - Mat3::Identity();
+      for (const char* face : {"xmin", "xmax", "ymin", "ymax", "zmin", "zmax"}) {
+        BoundarySpec b;
+        b.surface = face;
+        b.components = {true, true, true};
+        b.field = [G](const Eigen::Vector3d& X, double t) { return Eigen::Vector3d(t * G * X); };
+        s.boundary.push_back(b);
+      }
+      s.solver.t_end = 1.0;
+      s.solver.dt_initial = 0.5;
+      auto r = run_scene(s, comm, {false, opt.progress, {}});
+      check_completed(r, "patch test");
+      double err_u = 0, scale_u = 0, err_F = 0;
+      for (int n = 0; n < r.mesh.n_nodes(); ++n) {
+        const Eigen::Vector3d exact = G * r.mesh.X.row(n).transpose();
+        err_u = std::max(err_u, (r.u.row(n).transpose() - exact).norm());
+        scale_u = std::max(scale_u, exact.norm());
+      }
+      for (int c = 0; c < r.mesh.n_cells(); ++c)
+        err_F = std::max(err_F, (cell_F(r.mesh, r.u, c, Eigen::Vector3d(0.25, 0.25, 0.25)) - F).norm() / G.norm());
+      auto rec = record_of("patch", "max_rel_error_u_and_F", int(level), order, h, r);
+      rec.value = std::max(err_u / scale_u, err_F);
+      rec.reference = 0.0;
+      rec.rel_error = rec.value;
+      out.push_back(rec);
+    }
+}
+
+// ------------------------------------------------------- case 2: manufactured solution
+// u_k = a sin(c w_k.X + phi_k); body force B = -Div P(F(u)),
+// (Div P)_i = sum_{J,k,L} A_iJkL d2u_k/dX_J dX_L, with A = dP/dF at the exact F.
+struct Manufactured {
+  double a, c;
+  Eigen::Matrix3d w;  // row k: w_k
+  Eigen::Vector3d phi;
+  Eigen::Vector3d u(const Eigen::Vector3d& X) const {
+    Eigen::Vector3d out;
+    for (int k = 0; k < 3; ++k) out[k] = a * std::sin(c * w.row(k).dot(X) + phi[k]);
+    return out;
+  }
+  Eigen::Matrix3d grad(const Eigen::Vector3d& X) const {  // du_k/dX_J
+    Eigen::Matrix3d G;
+    for (int k = 0; k < 3; ++k) G.row(k) = a * c * std::cos(c * w.row(k).dot(X) + phi[k]) * w.row(k);
+    return G;
+  }
+};
+
+void mms_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<VerificationRecord>& out) {
+  const double L = 0.1;
+  Manufactured m;
+  m.c = kPi / L;
+  m.a = 0.04 / m.c;  // strains of a few percent
+  m.w << 1.0, 0.5, 0.3, 0.2, 1.0, 0.7, 0.6, 0.4, 1.0;
+  m.phi = Eigen::Vector3d(0.1, 0.7, 1.3);
+  ParamSet material = params({{"mu", 1e5}, {"kappa", 3e5}}, "model", "neo_hookean");
+  std::shared_ptr<const Material> law = make_material(material);
+  auto body_force = [m, law](const Eigen::Vector3d& X, double) {
+    Mat3 F = Mat3::Identity() + m.grad(X);
+    double W;
+    Mat3 P;
+    Tangent A;
+    law->evaluate(F, W, P, &A);
+    Eigen::Vector3d b = Eigen::Vector3d::Zero();
+    for (int i = 0; i < 3; ++i)
+      for (int J = 0; J < 3; ++J)
+        for (int k = 0; k < 3; ++k)
+          for (int Lx = 0; Lx < 3; ++Lx) {
+            const double d2u = -m.a * m.c * m.c * m.w(k, J) * m.w(k, Lx) * std::sin(m.c * m.w.row(k).dot(X) + m.phi[k]);
+            b[i] -= A(3 * i + J, 3 * k + Lx) * d2u;
+          }
+    return b;
+  };
+  std::map<int, std::vector<int>> ladder = opt.quick ? std::map<int, std::vector<int>>{{1, {2, 4}}, {2, {2, 4}}}
+                                                     : std::map<int, std::vector<int>>{{1, {4, 8, 16}}, {2, {2, 4, 8}}};
+  for (auto& [order, divisions] : ladder) {
+    double prev_L2 = 0, prev_H1 = 0, prev_h = 0;
+    for (size_t level = 0; level < divisions.size(); ++level) {
+      const double h = L / divisions[level];
+      Scene s = base_scene("mms", params({{"lx", L}, {"ly", L}, {"lz", L}, {"mesh_size", h}, {"order", double(order)},
+                                          {"structured", 1}}, "type", "block"),
+                           material);
+      for (const char* face : {"xmin", "xmax", "ymin", "ymax", "zmin", "zmax"}) {
+        BoundarySpec b;
+        b.surface = face;
+        b.components = {true, true, true};
+        b.field = [m](const Eigen::Vector3d& X, double t) { return Eigen::Vector3d(t * m.u(X)); };
+        s.boundary.push_back(b);
+      }
+      s.body_force = [body_force](const Eigen::Vector3d& X, double t) { return Eigen::Vector3d(t * body_force(X, t)); };
+      s.body_force_degree = 6;
+      s.solver.t_end = 1.0;
+      s.solver.dt_initial = 0.5;
+      auto r = run_scene(s, comm, {false, opt.progress, {}});
+      check_completed(r, "manufactured solution");
+      // Errors by degree-6 quadrature: ||u_h - u||_L2 / ||u||_L2, |u_h - u|_H1 / |u|_H1.
+      double e_L2 = 0, n_L2 = 0, e_H1 = 0, n_H1 = 0;
+      for (int c = 0; c < r.mesh.n_cells(); ++c)
+        for (const auto& q : tet_quadrature(6)) {
+          Eigen::Matrix3d Gh;
+          double detJ0;
+          Eigen::Vector3d X, uh;
+          cell_F(r.mesh, r.u, c, q.xi, &Gh, &detJ0, &X, &uh);
+          const double dV = q.weight * detJ0;
+          const Eigen::Vector3d ue = m.u(X);
+          const Eigen::Matrix3d Ge = m.grad(X);
+          e_L2 += dV * (uh - ue).squaredNorm();
+          n_L2 += dV * ue.squaredNorm();
+          e_H1 += dV * (Gh - Ge).squaredNorm();
+          n_H1 += dV * Ge.squaredNorm();
+        }
+      const double L2 = std::sqrt(e_L2 / n_L2), H1 = std::sqrt(e_H1 / n_H1);
+      for (int which = 0; which < 2; ++which) {
+        auto rec = record_of("mms", which == 0 ? "L2_error" : "H1_error", int(level), order, h, r);
+        rec.value = which == 0 ? L2 : H1;
+        rec.reference = 0;
+        rec.rel_error = rec.value;
+        const double prev = which == 0 ? prev_L2 : prev_H1;
+        if (level > 0) rec.rate = std::log(prev / rec.value) / std::log(prev_h / h);
+        out.push_back(rec);
+      }
+      prev_L2 = L2;
+      prev_H1 = H1;
+      prev_h = h;
+    }
+  }
+}
+
+// ------------------------------------------------ case 4: thick cylinder, plane strain
+// Incompressible neo-Hookean: P/mu = ln(la/lb) + 1/(2 lb^2) - 1/(2 la^2),
+// lb^2 = 1 + (la^2 - 1)(A/B)^2.
+double cylinder_pressure(double la, double ratio) {
+  const double lb = std::sqrt(1.0 + (la * la - 1.0) * ratio * ratio);
+  return std::log(la / lb) + 0.5 / (lb * lb) - 0.5 / (la * la);
+}
+
+void cylinder_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<VerificationRecord>& out) {
+  const double A = 0.01, B = 0.02, mu = 1e5, kappa = 1000 * mu;
+  const double p_over_mu = 0.574054;  // VERIFICATION.md case 4, A/B = 0.5, la = 2.0
+  std::vector<double> sizes = opt.quick ? std::vector<double>{A / 2} : std::vector<double>{A / 2, A / 4, A / 8};
+  std::vector<int> orders = opt.quick ? std::vector<int>{2} : std::vector<int>{1, 2};
+  for (int order : orders)
+    for (size_t level = 0; level < sizes.size(); ++level) {
+      const double h = sizes[level];
+      Scene s = base_scene("cylinder", params({{"inner_radius", A}, {"outer_radius", B}, {"mesh_size", h},
+                                               {"order", double(order)}}, "type", "thick_cylinder"),
+                           params({{"mu", mu}, {"kappa", kappa}}, "model", "neo_hookean"));
+      for (auto [face, axis] : std::vector<std::pair<const char*, int>>{{"sym_x", 0}, {"sym_y", 1}, {"zmin", 2}, {"zmax", 2}}) {
+        BoundarySpec b;
+        b.surface = face;
+        b.components[axis] = true;
+        s.boundary.push_back(b);
+      }
+      CavitySpec cavity;
+      cavity.name = "bore";
+      cavity.surfaces = {"inner"};
+      cavity.axes = {true, true, false};
+      cavity.pressure = TimeFunction::ramp(p_over_mu * mu, 1.0);
+      s.cavities.push_back(cavity);
+      s.solver.t_end = 1.0;
+      s.solver.dt_initial = 0.1;
+      s.solver.dt_max = 0.25;
+      auto r = run_scene(s, comm, {false, opt.progress, {}});
+      check_completed(r, "thick cylinder");
+      // Inner stretch from the inner wall's vertices: la = mean |x_xy| / A.
+      std::set<int> vertices;
+      for (int f : r.mesh.faces_of("inner"))
+        for (int a = 0; a < 3; ++a) vertices.insert(r.mesh.faces(f, a));
+      double sum = 0;
+      for (int n : vertices) {
+        Eigen::Vector3d x = r.mesh.X.row(n).transpose() + r.u.row(n).transpose();
+        sum += std::hypot(x[0], x[1]);
+      }
+      const double la = sum / vertices.size() / A;
+      auto rec = record_of("cylinder", "P/mu at computed inner stretch", int(level), order, h, r);
+      rec.value = p_over_mu;
+      rec.reference = cylinder_pressure(la, A / B);
+      rec.rel_error = std::abs(rec.value - rec.reference) / rec.reference;
+      out.push_back(rec);
+      auto srec = record_of("cylinder", "inner stretch (reference 2.0)", int(level), order, h, r);
+      srec.value = la;
+      srec.reference = 2.0;
+      srec.rel_error = std::abs(la - 2.0) / 2.0;
+      out.push_back(srec);
+    }
+}
+
+// ------------------------------------------ case 7: cantilever, dead end load (elastica)
+void cantilever_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<VerificationRecord>& out) {
+  const double L = 0.1, h = L / 50, b = h, mu = 1e6;
+  const double E = 2 * mu, I = b * h * h * h / 12.0;  // nu = 0: E = 2 mu, kappa = 2 mu / 3
+  const std::map<int, double> reference{{1, 0.30172}, {2, 0.49346}, {5, 0.71379}, {10, 0.81061}};
+  const double k_max = opt.quick ? 1.0 : 10.0;
+  std::vector<double> sizes = opt.quick ? std::vector<double>{h} : std::vector<double>{2 * h, h, h / 2};
+  for (int order : {1, 2}) {
+    if (opt.quick && order == 1) continue;
+    for (size_t level = 0; level < sizes.size(); ++level) {
+      const double size = sizes[level];
+      Scene s = base_scene("cantilever", params({{"L", L}, {"b", b}, {"h", h}, {"mesh_size", size},
+                                                 {"order", double(order)}, {"structured", 1}}, "type", "cantilever"),
+                           params({{"mu", mu}, {"kappa", 2 * mu / 3}}, "model", "neo_hookean"));
+      BoundarySpec clamp;
+      clamp.surface = "root";
+      clamp.components = {true, true, true};
+      s.boundary.push_back(clamp);
+      // k = P L^2 / (E I) grows linearly with t: k(t) = k_max t.
+      TractionSpec tip;
+      tip.surface = "tip";
+      tip.traction = Eigen::Vector3d(0, 0, -k_max * E * I / (L * L) / (b * h));
+      tip.scale = TimeFunction::ramp(1.0, 1.0);
+      s.tractions.push_back(tip);
+      s.solver.t_end = 1.0;
+      s.solver.dt_initial = 0.05;
+      s.solver.dt_max = 0.1;
+      for (const auto& [k, v] : reference)
+        if (k <= k_max) s.solver.output_times.push_back(k / k_max);
+      std::map<int, double> deflection;
+      RunOptions run{false, opt.progress, {}};
+      run.on_step = [&](double t, const Mesh& mesh, const RowMatrixXd& u, const SimulationResult&) {
+        for (const auto& [k, v] : reference)
+          if (std::abs(t - k / k_max) < 1e-9) {
+            auto nodes = mesh.nodes_of_surface("tip");
+            double w = 0;
+            for (int n : nodes) w -= u(n, 2);
+            deflection[k] = w / nodes.size() / L;
+          }
+      };
+      auto r = run_scene(s, comm, run);
+      check_completed(r, "cantilever");
+      for (const auto& [k, v] : deflection) {
+        auto rec = record_of("cantilever", "tip deflection v/L, k=" + std::to_string(k), int(level), order, size, r);
+        rec.value = v;
+        rec.reference = reference.at(k);
+        rec.rel_error = std::abs(v - rec.reference) / rec.reference;
+        out.push_back(rec);
+      }
+    }
+  }
+}
+
+const std::map<std::string, std::function<void(const VerifyOptions&, MPI_Comm, std::vector<VerificationRecord>&)>>&
+cases() {
+  static const std::map<std::string, std::function<void(const VerifyOptions&, MPI_Comm, std::vector<VerificationRecord>&)>>
+      registry{{"patch", patch_case}, {"mms", mms_case}, {"cylinder", cylinder_case}, {"cantilever", cantilever_case}};
+  return registry;
+}
+
+}  // namespace
+
+std::vector<std::string> verification_case_names() { return {"patch", "mms", "cylinder", "cantilever"}; }
+
+std::vector<VerificationRecord> run_verification(const VerifyOptions& options, MPI_Comm comm) {
+  std::vector<std::string> names = options.cases.empty() ? verification_case_names() : options.cases;
+  for (const auto& n : names)
+    if (!cases().count(n)) {
+      std::string known;
+      for (const auto& k : verification_case_names()) known += (known.empty() ? "" : ", ") + k;
+      throw InputError("--case", "unknown verification case '" + n + "' (known: " + known + ")");
+    }
+  std::vector<VerificationRecord> out;
+  for (const auto& n : names) cases().at(n)(options, comm, out);
+  return out;
+}
+
+}  // namespace morphfem

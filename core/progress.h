@@ -1,0 +1,27 @@
+// Progress line with elapsed time and ETA for long runs, written to stderr on
+// rank 0 only. Quiet when stderr is not a terminal unless forced (CI logs stay small).
+#pragma once
+#include <chrono>
+#include <string>
+
+namespace morphfem {
+
+class Progress {
+ public:
+  // `total` is the amount of work in any unit (simulated seconds, load factor, runs).
+  Progress(std::string label, double total, bool enabled = true);
+  // Report that `done` of `total` is complete; `info` is appended (e.g. "step 12").
+  void update(double done, const std::string& info = "");
+  void finish(const std::string& info = "");
+
+ private:
+  std::string label_;
+  double total_;
+  bool enabled_;
+  bool tty_;
+  std::chrono::steady_clock::time_point start_, last_;
+};
+
+std::string format_seconds(double s);
+
+}  // namespace morphfem

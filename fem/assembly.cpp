@@ -1,0 +1,234 @@
+#include "fem/assembly.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include "fem/petsc_check.h"
+
+namespace morphfem {
+
+Assembler::Assembler(const Mesh& mesh, const Partition& partition, MPI_Comm comm)
+    : mesh_(mesh), partition_(partition), comm_(comm) {
+  MPI_Comm_rank(comm, &rank_);
+  constrained_.assign(3 * mesh.n_nodes(), 0);
+  slot_.assign(mesh.n_nodes(), -1);
+}
+
+Assembler::~Assembler() {
+  if (ghost_vec_) VecDestroy(&ghost_vec_);
+  if (scatter_) VecScatterDestroy(&scatter_);
+  if (pattern_) MatDestroy(&pattern_);
+}
+
+void Assembler::add_term(std::shared_ptr<EnergyTerm> term) { terms_.push_back(std::move(term)); }
+
+void Assembler::set_constrained(const std::vector<int>& dofs) {
+  std::fill(constrained_.begin(), constrained_.end(), 0);
+  for (int d : dofs) constrained_.at(d) = 1;
+}
+
+Vec Assembler::create_vector() const {
+  Vec v;
+  PETSC_CHECK(VecCreate(comm_, &v));
+  PETSC_CHECK(VecSetSizes(v, owned_dof_end() - owned_dof_begin(), n_dofs()));
+  PETSC_CHECK(VecSetBlockSize(v, 3));
+  PETSC_CHECK(VecSetFromOptions(v));
+  PETSC_CHECK(VecSet(v, 0.0));
+  return v;
+}
+
+Mat Assembler::create_matrix() const {
+  Mat m;
+  PETSC_CHECK(MatDuplicate(pattern_, MAT_DO_NOT_COPY_VALUES, &m));
+  PETSC_CHECK(MatSetOption(m, MAT_ROW_ORIENTED, PETSC_FALSE));  // Eigen is column-major
+  return m;
+}
+
+void Assembler::load_piece(int k, const EnergyTerm& term, PieceState& s,
+                           std::vector<int>& nodes) const {
+  term.piece_nodes(k, nodes);
+  const int n = static_cast<int>(nodes.size());
+  s.X.resize(n, 3);
+  s.u.resize(n, 3);
+  for (int a = 0; a < n; ++a) {
+    const int slot = slot_[nodes[a]];
+    for (int i = 0; i < 3; ++i) {
+      s.X(a, i) = mesh_.X(nodes[a], i);
+      s.u(a, i) = ghost_u_[3 * slot + i];
+    }
+  }
+}
+
+void Assembler::setup() {
+  // Nodes this rank needs: its owned nodes and every node of its pieces.
+  std::fill(slot_.begin(), slot_.end(), -1);
+  std::vector<char> needed(mesh_.n_nodes(), 0);
+  for (int n = partition_.node_begin[rank_]; n < partition_.node_begin[rank_ + 1]; ++n) needed[n] = 1;
+  std::vector<int> nodes;
+  for (const auto& term : terms_)
+    for (int k = 0; k < term->n_pieces(); ++k) {
+      term->piece_nodes(k, nodes);
+      for (int n : nodes) needed[n] = 1;
+    }
+  ghost_nodes_.clear();
+  for (int n = 0; n < mesh_.n_nodes(); ++n)
+    if (needed[n]) {
+      slot_[n] = static_cast<int>(ghost_nodes_.size());
+      ghost_nodes_.push_back(n);
+    }
+  ghost_u_.assign(3 * ghost_nodes_.size(), 0.0);
+
+  if (ghost_vec_) VecDestroy(&ghost_vec_);
+  if (scatter_) VecScatterDestroy(&scatter_);
+  Vec u = create_vector();
+  IS is;
+  std::vector<PetscInt> block_ids(ghost_nodes_.begin(), ghost_nodes_.end());
+  PETSC_CHECK(ISCreateBlock(PETSC_COMM_SELF, 3, static_cast<PetscInt>(block_ids.size()), block_ids.data(),
+                            PETSC_COPY_VALUES, &is));
+  PETSC_CHECK(VecCreateSeq(PETSC_COMM_SELF, 3 * static_cast<PetscInt>(ghost_nodes_.size()), &ghost_vec_));
+  PETSC_CHECK(VecScatterCreate(u, is, ghost_vec_, nullptr, &scatter_));
+  PETSC_CHECK(ISDestroy(&is));
+  PETSC_CHECK(VecDestroy(&u));
+
+  // Nonzero pattern: a dry run of the Hessian assembly into a MATPREALLOCATOR.
+  const PetscInt n_local = owned_dof_end() - owned_dof_begin();
+  Mat pre;
+  PETSC_CHECK(MatCreate(comm_, &pre));
+  PETSC_CHECK(MatSetType(pre, MATPREALLOCATOR));
+  PETSC_CHECK(MatSetSizes(pre, n_local, n_local, n_dofs(), n_dofs()));
+  PETSC_CHECK(MatSetBlockSize(pre, 3));
+  PETSC_CHECK(MatSetUp(pre));
+  std::vector<PetscInt> idx;
+  std::vector<PetscScalar> zeros;
+  for (const auto& term : terms_)
+    for (int k = 0; k < term->n_pieces(); ++k) {
+      term->piece_nodes(k, nodes);
+      idx.clear();
+      for (int n : nodes)
+        for (int i = 0; i < 3; ++i) idx.push_back(constrained_[3 * n + i] ? -1 : 3 * n + i);
+      zeros.assign(idx.size() * idx.size(), 0.0);
+      PETSC_CHECK(MatSetValues(pre, static_cast<PetscInt>(idx.size()), idx.data(),
+                               static_cast<PetscInt>(idx.size()), idx.data(), zeros.data(), ADD_VALUES));
+    }
+  for (PetscInt d = owned_dof_begin(); d < owned_dof_end(); ++d) {
+    PetscScalar zero = 0.0;
+    PETSC_CHECK(MatSetValues(pre, 1, &d, 1, &d, &zero, ADD_VALUES));  // every diagonal
+  }
+  PETSC_CHECK(MatAssemblyBegin(pre, MAT_FINAL_ASSEMBLY));
+  PETSC_CHECK(MatAssemblyEnd(pre, MAT_FINAL_ASSEMBLY));
+  if (pattern_) MatDestroy(&pattern_);
+  PETSC_CHECK(MatCreate(comm_, &pattern_));
+  PETSC_CHECK(MatSetType(pattern_, MATAIJ));
+  PETSC_CHECK(MatSetSizes(pattern_, n_local, n_local, n_dofs(), n_dofs()));
+  PETSC_CHECK(MatSetBlockSize(pattern_, 3));
+  PETSC_CHECK(MatPreallocatorPreallocate(pre, PETSC_TRUE, pattern_));
+  PETSC_CHECK(MatSetOption(pattern_, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE));
+  PETSC_CHECK(MatDestroy(&pre));
+}
+
+const std::vector<double>& Assembler::gather(Vec u) {
+  PETSC_CHECK(VecScatterBegin(scatter_, u, ghost_vec_, INSERT_VALUES, SCATTER_FORWARD));
+  PETSC_CHECK(VecScatterEnd(scatter_, u, ghost_vec_, INSERT_VALUES, SCATTER_FORWARD));
+  const PetscScalar* a;
+  PETSC_CHECK(VecGetArrayRead(ghost_vec_, &a));
+  std::copy(a, a + ghost_u_.size(), ghost_u_.begin());
+  PETSC_CHECK(VecRestoreArrayRead(ghost_vec_, &a));
+  return ghost_u_;
+}
+
+// The one loop over pieces of every term. visit(term_index, piece_index, dof
+// indices, energy, g, H) receives each piece's contribution.
+template <class Visit>
+double Assembler::sweep(Vec u, bool want_g, bool want_H, Visit&& visit) {
+  gather(u);
+  PieceState s;
+  std::vector<int> nodes;
+  std::vector<PetscInt> idx;
+  Eigen::VectorXd g;
+  Eigen::MatrixXd H;
+  double local = 0.0;
+  for (size_t t = 0; t < terms_.size(); ++t) {
+    EnergyTerm& term = *terms_[t];
+    term.prepare(*this, ghost_u_);
+    for (int k = 0; k < term.n_pieces(); ++k) {
+      load_piece(k, term, s, nodes);
+      double e = term.piece(k, s, want_g ? &g : nullptr, want_H ? &H : nullptr);
+      idx.clear();
+      for (int n : nodes)
+        for (int i = 0; i < 3; ++i) idx.push_back(constrained_[3 * n + i] ? -1 : 3 * n + i);
+      local += e;
+      visit(t, k, idx, e, g, H);
+    }
+  }
+  double total = 0.0;
+  MPI_Allreduce(&local, &total, 1, MPI_DOUBLE, MPI_SUM, comm_);
+  if (std::isnan(total)) total = std::numeric_limits<double>::infinity();
+  return total;
+}
+
+double Assembler::energy(Vec u) {
+  return sweep(u, false, false, [](auto&&...) {});
+}
+
+std::vector<double> Assembler::term_energies(Vec u) {
+  std::vector<double> local(terms_.size(), 0.0), total(terms_.size(), 0.0);
+  sweep(u, false, false, [&](size_t t, int, const auto&, double e, const auto&, const auto&) { local[t] += e; });
+  MPI_Allreduce(local.data(), total.data(), static_cast<int>(local.size()), MPI_DOUBLE, MPI_SUM, comm_);
+  return total;
+}
+
+double Assembler::gradient(Vec u, Vec gvec) {
+  PETSC_CHECK(VecSet(gvec, 0.0));
+  // Constrained dofs carry index -1; PETSc vectors skip them only with this option.
+  PETSC_CHECK(VecSetOption(gvec, VEC_IGNORE_NEGATIVE_INDICES, PETSC_TRUE));
+  double e = sweep(u, true, false, [&](size_t, int, const std::vector<PetscInt>& idx, double energy,
+                                       const Eigen::VectorXd& g, const Eigen::MatrixXd&) {
+    if (!std::isfinite(energy)) return;  // outside the domain: no meaningful gradient
+    PETSC_CHECK(VecSetValues(gvec, static_cast<PetscInt>(idx.size()), idx.data(), g.data(), ADD_VALUES));
+  });
+  PETSC_CHECK(VecAssemblyBegin(gvec));
+  PETSC_CHECK(VecAssemblyEnd(gvec));
+  return e;
+}
+
+void Assembler::hessian(Vec u, Mat Hmat) {
+  PETSC_CHECK(MatZeroEntries(Hmat));
+  sweep(u, false, true, [&](size_t, int, const std::vector<PetscInt>& idx, double energy,
+                            const Eigen::VectorXd&, const Eigen::MatrixXd& H) {
+    if (!std::isfinite(energy)) return;
+    const PetscInt n = static_cast<PetscInt>(idx.size());
+    PETSC_CHECK(MatSetValues(Hmat, n, idx.data(), n, idx.data(), H.data(), ADD_VALUES));
+  });
+  for (PetscInt d = owned_dof_begin(); d < owned_dof_end(); ++d)
+    if (constrained_[d]) PETSC_CHECK(MatSetValue(Hmat, d, d, 1.0, ADD_VALUES));
+  PETSC_CHECK(MatAssemblyBegin(Hmat, MAT_FINAL_ASSEMBLY));
+  PETSC_CHECK(MatAssemblyEnd(Hmat, MAT_FINAL_ASSEMBLY));
+}
+
+RowMatrixXd Assembler::gather_all(Vec u) const {
+  VecScatter to_all;
+  Vec all;
+  PETSC_CHECK(VecScatterCreateToAll(u, &to_all, &all));
+  PETSC_CHECK(VecScatterBegin(to_all, u, all, INSERT_VALUES, SCATTER_FORWARD));
+  PETSC_CHECK(VecScatterEnd(to_all, u, all, INSERT_VALUES, SCATTER_FORWARD));
+  RowMatrixXd field(mesh_.n_nodes(), 3);
+  const PetscScalar* a;
+  PETSC_CHECK(VecGetArrayRead(all, &a));
+  std::copy(a, a + field.size(), field.data());
+  PETSC_CHECK(VecRestoreArrayRead(all, &a));
+  PETSC_CHECK(VecScatterDestroy(&to_all));
+  PETSC_CHECK(VecDestroy(&all));
+  return field;
+}
+
+void Assembler::scatter_all(const RowMatrixXd& field, Vec u) const {
+  PetscScalar* a;
+  PETSC_CHECK(VecGetArray(u, &a));
+  for (PetscInt d = owned_dof_begin(); d < owned_dof_end(); ++d)
+    a[d - owned_dof_begin()] = field(d / 3, d % 3);
+  PETSC_CHECK(VecRestoreArray(u, &a));
+}
+
+}  // namespace morphfem

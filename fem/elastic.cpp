@@ -1,0 +1,99 @@
+#include "fem/elastic.h"
+
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+namespace morphfem {
+
+ElasticTerm::ElasticTerm(const Mesh& mesh, const Partition& partition, int rank,
+                         std::vector<std::shared_ptr<const Material>> materials, int quadrature_degree)
+    : mesh_(mesh), materials_(std::move(materials)) {
+  for (int c = 0; c < mesh.n_cells(); ++c)
+    if (partition.cell_part[c] == rank) {
+      if (!materials_.at(mesh.cell_region[c]))
+        throw std::invalid_argument("cell region '" + mesh.regions[mesh.cell_region[c]].name +
+                                    "' has no material");
+      cells_.push_back(c);
+    }
+  int degree = quadrature_degree > 0 ? quadrature_degree : (mesh.order == 1 ? 1 : 2);
+  table_ = make_tet_table(mesh.order, degree);
+}
+
+void ElasticTerm::piece_nodes(int k, std::vector<int>& nodes) const {
+  const int c = cells_[k];
+  nodes.assign(mesh_.cells.row(c).data(), mesh_.cells.row(c).data() + mesh_.nodes_per_cell());
+}
+
+namespace {
+// Reference-to-physical gradients at one quadrature point:
+//   J0 = dX/dxi (3x3), dN/dX = dN/dxi J0^-1, returns det J0 (> 0 for a valid mesh).
+double physical_gradients(const Eigen::MatrixXd& X, const Eigen::MatrixXd& dN_dxi, Eigen::MatrixXd& dN_dX) {
+  Eigen::Matrix3d J0 = X.transpose() * dN_dxi;  // J0(i,k) = sum_a X_ai dN_a/dxi_k
+  const double det = J0.determinant();
+  dN_dX = dN_dxi * J0.inverse();
+  return det;
+}
+}  // namespace
+
+double ElasticTerm::piece(int k, const PieceState& s, Eigen::VectorXd* g, Eigen::MatrixXd* H) const {
+  const Material& material = *materials_[mesh_.cell_region[cells_[k]]];
+  const int n = static_cast<int>(s.X.rows());
+  if (g) g->setZero(3 * n);
+  if (H) H->setZero(3 * n, 3 * n);
+  Eigen::MatrixXd dN_dX, B;
+  double energy = 0.0;
+  Mat3 P;
+  Tangent A;
+  for (size_t q = 0; q < table_.points.size(); ++q) {
+    const double dV = table_.points[q].weight * physical_gradients(s.X, table_.dN[q], dN_dX);
+    // F_iJ = delta_iJ + sum_a u_ai dN_a/dX_J
+    Mat3 F = Mat3::Identity() + s.u.transpose() * dN_dX;
+    if (F.determinant() <= 0.0) return std::numeric_limits<double>::infinity();
+    if (!g && !H) {
+      energy += dV * material.energy(F);
+      continue;
+    }
+    double W;
+    material.evaluate(F, W, P, H ? &A : nullptr);
+    energy += dV * W;
+    // B(3i+J, 3b+k) = dF_iJ / du_bk = delta_ik dN_b/dX_J
+    B.setZero(9, 3 * n);
+    for (int b = 0; b < n; ++b)
+      for (int i = 0; i < 3; ++i)
+        for (int J = 0; J < 3; ++J) B(3 * i + J, 3 * b + i) = dN_dX(b, J);
+    if (g) {
+      const Eigen::Matrix<double, 3, 3, Eigen::RowMajor> P_rows = P;  // flatten as 3*i + J
+      *g += dV * B.transpose() * Eigen::Map<const Eigen::Matrix<double, 9, 1>>(P_rows.data());
+    }
+    if (H) H->noalias() += dV * B.transpose() * A * B;
+  }
+  return energy;
+}
+
+ElasticTerm::CellMeasures ElasticTerm::measures(int k, const PieceState& s) const {
+  const Material& material = *materials_[mesh_.cell_region[cells_[k]]];
+  Eigen::MatrixXd dN_dX;
+  double volume = 0.0, J_sum = 0.0, J_min = std::numeric_limits<double>::infinity(), vm_sum = 0.0;
+  for (size_t q = 0; q < table_.points.size(); ++q) {
+    const double dV = table_.points[q].weight * physical_gradients(s.X, table_.dN[q], dN_dX);
+    Mat3 F = Mat3::Identity() + s.u.transpose() * dN_dX;
+    const double J = F.determinant();
+    double W;
+    Mat3 P;
+    double vm = 0.0;
+    if (J > 0) {
+      material.evaluate(F, W, P, nullptr);
+      Mat3 sigma = P * F.transpose() / J;  // Cauchy stress [Pa]
+      Mat3 dev = sigma - sigma.trace() / 3.0 * Mat3::Identity();
+      vm = std::sqrt(1.5 * dev.squaredNorm());
+    }
+    volume += dV;
+    J_sum += dV * J;
+    vm_sum += dV * vm;
+    J_min = std::min(J_min, J);
+  }
+  return {J_sum / volume, J_min, vm_sum / volume};
+}
+
+}  // namespace morphfem

@@ -1,0 +1,65 @@
+// Hyperelastic material laws. A law is a parameter struct plus pure functions of
+// the deformation gradient F returning the strain-energy density W [J/m^3 = Pa],
+// the first Piola-Kirchhoff stress P = dW/dF [Pa] and the tangent
+// A = dP/dF [Pa]. No PETSc objects in here.
+//
+// Index convention: F, P flattened row-major, a = 3*i + J for F_iJ, so
+// A(3*i+J, 3*k+L) = d P_iJ / d F_kL.
+//
+// Every law is split into an isochoric part (function of Fbar = J^(-1/3) F) and a
+// volumetric part U(J) = kappa/4 (J^2 - 1 - 2 ln J) (kappa: bulk modulus [Pa]),
+// which is convex in J and infinite as J -> 0.
+#pragma once
+#include <Eigen/Dense>
+#include <functional>
+#include <map>
+#include <memory>
+#include <string>
+
+#include "core/params.h"
+
+namespace morphfem {
+
+using Mat3 = Eigen::Matrix3d;
+using Tangent = Eigen::Matrix<double, 9, 9>;
+
+class Material {
+ public:
+  virtual ~Material() = default;
+  virtual std::string name() const = 0;
+  // Energy density W(F) [Pa]; +infinity if det F <= 0.
+  virtual double energy(const Mat3& F) const = 0;
+  // W, P and (if A != nullptr) A at F. Requires det F > 0.
+  virtual void evaluate(const Mat3& F, double& W, Mat3& P, Tangent* A) const = 0;
+  // Small-strain shear and bulk moduli [Pa] (for reporting, time steps, penalties).
+  virtual double shear_modulus() const = 0;
+  virtual double bulk_modulus() const = 0;
+};
+
+using MaterialFactory = std::function<std::unique_ptr<Material>(const ParamSet&)>;
+
+// name -> factory. Names: neo_hookean (mu, kappa), mooney_rivlin (c10, c01, kappa),
+// yeoh (c1, c2, c3, kappa), ogden (mu: [..], alpha: [..], kappa). Presets
+// dragon_skin_10 and dragon_skin_30 take optional kappa. The bulk modulus may be
+// given as kappa [Pa] or as Poisson's ratio nu.
+const std::map<std::string, MaterialFactory>& material_registry();
+
+// Builds `params.string("model")`; unknown names and bad parameters throw InputError.
+std::unique_ptr<Material> make_material(const ParamSet& params);
+
+// Law factories (one file each: fem/material_<name>.cpp), registered by name in
+// fem/material.cpp. Each validates its keys (allow_only) and ranges.
+std::unique_ptr<Material> make_neo_hookean(const ParamSet& params);
+std::unique_ptr<Material> make_mooney_rivlin(const ParamSet& params);
+std::unique_ptr<Material> make_yeoh(const ParamSet& params);
+std::unique_ptr<Material> make_ogden(const ParamSet& params);
+
+// Helpers for the factories.
+// Bulk modulus [Pa] from `kappa` [Pa] or Poisson's ratio `nu` (exactly one is
+// required): kappa = 2 mu0 (1 + nu) / (3 (1 - 2 nu)), mu0 = small-strain shear modulus.
+double bulk_modulus_from_params(const ParamSet& params, double mu0);
+// `key` must be a number in (0, hi]; the message says what the parameter is.
+double positive_parameter(const ParamSet& params, const std::string& key, double hi,
+                          const std::string& what);
+
+}  // namespace morphfem

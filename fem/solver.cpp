@@ -1,0 +1,306 @@
+#include "fem/solver.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <sstream>
+
+#include "core/errors.h"
+#include "fem/petsc_check.h"
+
+namespace morphfem {
+
+namespace {
+
+PetscErrorCode form_function(SNES snes, Vec u, Vec r, void* ctx) {
+  auto* self = static_cast<QuasiStaticSolver*>(ctx);
+  try {
+    double e = self->assembler().gradient(u, r);
+    if (!std::isfinite(e)) PetscCall(SNESSetFunctionDomainError(snes));
+  } catch (const std::exception& ex) {
+    SETERRQ(PETSC_COMM_SELF, PETSC_ERR_LIB, "%s", ex.what());
+  }
+  return 0;
+}
+
+PetscErrorCode form_jacobian(SNES, Vec u, Mat J, Mat P, void* ctx) {
+  auto* self = static_cast<QuasiStaticSolver*>(ctx);
+  try {
+    self->assembler().hessian(u, P);
+  } catch (const std::exception& ex) {
+    SETERRQ(PETSC_COMM_SELF, PETSC_ERR_LIB, "%s", ex.what());
+  }
+  if (J != P) {
+    PetscCall(MatAssemblyBegin(J, MAT_FINAL_ASSEMBLY));
+    PetscCall(MatAssemblyEnd(J, MAT_FINAL_ASSEMBLY));
+  }
+  return 0;
+}
+
+PetscErrorCode form_objective(SNES, Vec u, PetscReal* e, void* ctx) {
+  *e = static_cast<QuasiStaticSolver*>(ctx)->assembler().energy(u);
+  return 0;
+}
+
+PetscErrorCode line_search_trampoline(SNESLineSearch ls, void* ctx) {
+  return static_cast<QuasiStaticSolver*>(ctx)->line_search(ls);
+}
+
+PetscErrorCode convergence_trampoline(SNES snes, PetscInt it, PetscReal, PetscReal snorm, PetscReal fnorm,
+                                      SNESConvergedReason* reason, void* ctx) {
+  return static_cast<QuasiStaticSolver*>(ctx)->convergence(snes, it, snorm, fnorm, reason);
+}
+
+}  // namespace
+
+QuasiStaticSolver::QuasiStaticSolver(Assembler& assembler, std::vector<DirichletCondition> bcs, SolverOptions options)
+    : assembler_(assembler), bcs_(std::move(bcs)), opt_(std::move(options)) {
+  std::vector<int> dofs;
+  for (const auto& bc : bcs_)
+    for (int n : bc.nodes)
+      for (int i = 0; i < 3; ++i)
+        if (bc.components[i]) dofs.push_back(3 * n + i);
+  assembler_.set_constrained(dofs);
+  const Mesh& mesh = assembler_.mesh();
+  length_scale_ = (mesh.X.colwise().maxCoeff() - mesh.X.colwise().minCoeff()).norm();
+  assembler_.setup();
+  u_ = assembler_.create_vector();
+  u_prev_ = assembler_.create_vector();
+  work_ = assembler_.create_vector();
+  H_ = assembler_.create_matrix();
+
+  PETSC_CHECK(SNESCreate(assembler_.comm(), &snes_));
+  PETSC_CHECK(SNESSetType(snes_, SNESNEWTONLS));
+  PETSC_CHECK(SNESSetFunction(snes_, work_, form_function, this));
+  PETSC_CHECK(SNESSetJacobian(snes_, H_, H_, form_jacobian, this));
+  PETSC_CHECK(SNESSetObjective(snes_, form_objective, this));
+  PETSC_CHECK(SNESSetConvergenceTest(snes_, convergence_trampoline, this, nullptr));
+  PETSC_CHECK(SNESSetTolerances(snes_, 0.0, 0.0, 0.0, opt_.max_newton_its, 100000));
+  SNESLineSearch ls;
+  PETSC_CHECK(SNESGetLineSearch(snes_, &ls));
+  PETSC_CHECK(SNESLineSearchSetType(ls, SNESLINESEARCHSHELL));
+  PETSC_CHECK(SNESLineSearchShellSetUserFunc(ls, line_search_trampoline, this));
+
+  KSP ksp;
+  PC pc;
+  PETSC_CHECK(SNESGetKSP(snes_, &ksp));
+  PETSC_CHECK(KSPGetPC(ksp, &pc));
+  if (opt_.linear_solver == "mumps") {
+    PETSC_CHECK(KSPSetType(ksp, KSPPREONLY));
+    PETSC_CHECK(PCSetType(pc, PCLU));
+    PETSC_CHECK(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
+  } else if (opt_.linear_solver == "gamg") {
+    PETSC_CHECK(KSPSetType(ksp, KSPCG));
+    PETSC_CHECK(PCSetType(pc, PCGAMG));
+    PETSC_CHECK(KSPSetTolerances(ksp, 1e-10, 1e-50, PETSC_DEFAULT, 2000));
+    // Rigid-body modes from the reference coordinates of the owned nodes.
+    Vec coords = assembler_.create_vector();
+    assembler_.scatter_all(assembler_.mesh().X, coords);
+    MatNullSpace near_null;
+    PETSC_CHECK(MatNullSpaceCreateRigidBody(coords, &near_null));
+    PETSC_CHECK(MatSetNearNullSpace(H_, near_null));
+    PETSC_CHECK(MatNullSpaceDestroy(&near_null));
+    PETSC_CHECK(VecDestroy(&coords));
+  } else {
+    throw InputError("solver.linear_solver", "unknown linear solver '" + opt_.linear_solver +
+                                                 "' (allowed: mumps, gamg)");
+  }
+  PETSC_CHECK(SNESSetFromOptions(snes_));
+  apply_dirichlet(u_, 0.0);
+}
+
+QuasiStaticSolver::~QuasiStaticSolver() {
+  SNESDestroy(&snes_);
+  MatDestroy(&H_);
+  VecDestroy(&u_);
+  VecDestroy(&u_prev_);
+  VecDestroy(&work_);
+}
+
+void QuasiStaticSolver::apply_dirichlet(Vec u, double t) const {
+  const PetscInt begin = assembler_.owned_dof_begin(), end = assembler_.owned_dof_end();
+  const Mesh& mesh = assembler_.mesh();
+  PetscScalar* a;
+  PETSC_CHECK(VecGetArray(u, &a));
+  for (const auto& bc : bcs_)
+    for (int n : bc.nodes) {
+      if (3 * n < begin || 3 * n >= end) continue;
+      const Eigen::Vector3d value = bc.value(mesh.X.row(n).transpose(), t);
+      for (int i = 0; i < 3; ++i)
+        if (bc.components[i]) a[3 * n + i - begin] = value[i];
+    }
+  PETSC_CHECK(VecRestoreArray(u, &a));
+}
+
+// Energy-based backtracking (Armijo) along the Newton direction: W = X - lambda Y.
+// Rejects states with infinite energy (outside the domain); if the direction is
+// not a descent direction (indefinite Hessian), falls back to steepest descent.
+PetscErrorCode QuasiStaticSolver::line_search(SNESLineSearch ls) {
+  Vec X, F, Y, W, G;
+  PetscCall(SNESLineSearchGetVecs(ls, &X, &F, &Y, &W, &G));
+  SNES snes;
+  PetscCall(SNESLineSearchGetSNES(ls, &snes));
+  const double e0 = assembler_.energy(X);
+  PetscReal slope;  // d/dlambda E(X - lambda Y) at 0 = -F.Y
+  PetscCall(VecDot(F, Y, &slope));
+  slope = -slope;
+  if (!(slope < 0)) {
+    PetscReal ynorm, fnorm;
+    PetscCall(VecNorm(Y, NORM_2, &ynorm));
+    PetscCall(VecNorm(F, NORM_2, &fnorm));
+    PetscCall(VecCopy(F, Y));
+    if (fnorm > 0) PetscCall(VecScale(Y, ynorm / fnorm));
+    slope = -ynorm * fnorm;
+  }
+  PetscReal fnorm_old;
+  PetscCall(VecNorm(F, NORM_2, &fnorm_old));
+  double lambda = 1.0;
+  bool accepted = false;
+  for (int attempt = 0; attempt < 40 && !accepted; ++attempt, lambda *= 0.5) {
+    PetscCall(VecWAXPY(W, -lambda, Y, X));
+    const double e = assembler_.energy(W);
+    if (!std::isfinite(e)) continue;
+    const double noise = 1e-12 * std::max(1.0, std::abs(e0));
+    if (e <= e0 + 1e-4 * lambda * slope) {
+      accepted = true;
+    } else if (e <= e0 + noise) {
+      // Energy change below round-off: accept if the residual decreases.
+      PetscCall(SNESComputeFunction(snes, W, G));
+      PetscReal gnorm;
+      PetscCall(VecNorm(G, NORM_2, &gnorm));
+      accepted = gnorm < fnorm_old;
+    }
+    if (accepted) break;
+  }
+  if (!accepted) {
+    PetscCall(SNESLineSearchSetReason(ls, SNES_LINESEARCH_FAILED_REDUCT));
+    return 0;
+  }
+  PetscCall(SNESLineSearchSetLambda(ls, lambda));
+  PetscCall(VecCopy(W, X));
+  PetscCall(SNESComputeFunction(snes, X, F));
+  PetscCall(SNESLineSearchComputeNorms(ls));
+  PetscCall(SNESLineSearchSetReason(ls, SNES_LINESEARCH_SUCCEEDED));
+  return 0;
+}
+
+// Converged when the residual [N] fell by rtol, or is below atol_factor times the
+// largest initial residual of the run, or when the Newton update is at round-off
+// level (RMS below 1e-13 of the body's size) after the residual fell by 1e6:
+// then the residual is as small as double precision can make it.
+PetscErrorCode QuasiStaticSolver::convergence(SNES, PetscInt it, PetscReal snorm, PetscReal fnorm,
+                                              SNESConvergedReason* reason) {
+  *reason = SNES_CONVERGED_ITERATING;
+  if (it == 0) {
+    fnorm0_ = fnorm;
+    fnorm_scale_ = std::max(fnorm_scale_, fnorm);
+  }
+  if (std::isnan(fnorm)) {
+    *reason = SNES_DIVERGED_FNORM_NAN;
+  } else if (fnorm <= opt_.atol_factor * fnorm_scale_ || fnorm == 0.0) {
+    *reason = SNES_CONVERGED_FNORM_ABS;
+  } else if (it > 0 && fnorm <= opt_.rtol * fnorm0_) {
+    *reason = SNES_CONVERGED_FNORM_RELATIVE;
+  } else if (it > 0 && fnorm <= 1e-6 * fnorm0_ &&
+             snorm <= 1e-13 * length_scale_ * std::sqrt(double(assembler_.n_dofs()))) {
+    *reason = SNES_CONVERGED_SNORM_RELATIVE;
+  } else if (it >= opt_.max_newton_its) {
+    *reason = SNES_DIVERGED_MAX_IT;
+  }
+  return 0;
+}
+
+bool QuasiStaticSolver::solve_step(double t_new, int& newton_its, int& linear_its, std::string& why) {
+  // Predictor: linear extrapolation of the last increment, if it is admissible.
+  PETSC_CHECK(VecCopy(u_, work_));
+  const double dt = t_new - t_;
+  if (dt_prev_ > 0) {  // work = u + (dt/dt_prev) (u - u_prev)
+    PETSC_CHECK(VecAXPY(work_, dt / dt_prev_, u_));
+    PETSC_CHECK(VecAXPY(work_, -dt / dt_prev_, u_prev_));
+  }
+  for (const auto& term : assembler_.terms()) term->set_time(t_new);
+  apply_dirichlet(work_, t_new);
+  if (!std::isfinite(assembler_.energy(work_))) {
+    PETSC_CHECK(VecCopy(u_, work_));
+    apply_dirichlet(work_, t_new);
+    if (!std::isfinite(assembler_.energy(work_))) {
+      why = "the prescribed displacement increment inverts an element";
+      return false;
+    }
+  }
+  Vec x;
+  PETSC_CHECK(VecDuplicate(u_, &x));
+  PETSC_CHECK(VecCopy(work_, x));
+  PetscErrorCode ierr = SNESSolve(snes_, nullptr, x);
+  SNESConvergedReason reason = SNES_DIVERGED_FUNCTION_DOMAIN;
+  if (!ierr) {
+    SNESGetConvergedReason(snes_, &reason);
+    PetscInt its = 0, lits = 0;
+    SNESGetIterationNumber(snes_, &its);
+    SNESGetLinearSolveIterations(snes_, &lits);
+    newton_its = static_cast<int>(its);
+    linear_its = static_cast<int>(lits);
+  }
+  const bool ok = !ierr && reason > 0 && std::isfinite(assembler_.energy(x));
+  if (ok) {
+    PETSC_CHECK(VecCopy(u_, u_prev_));
+    PETSC_CHECK(VecCopy(x, u_));
+    dt_prev_ = dt;
+    t_ = t_new;
+  } else {
+    why = ierr ? "PETSc error during the solve" : std::string("Newton: ") + SNESConvergedReasons[reason];
+    for (const auto& term : assembler_.terms()) term->set_time(t_);
+  }
+  VecDestroy(&x);
+  return ok;
+}
+
+RunStats QuasiStaticSolver::run(const std::function<void(const StepReport&)>& on_step) {
+  auto start = std::chrono::steady_clock::now();
+  RunStats stats;
+  for (const auto& term : assembler_.terms()) term->set_time(t_);
+  std::vector<double> stops = opt_.output_times;
+  stops.push_back(opt_.t_end);
+  std::sort(stops.begin(), stops.end());
+  double dt = std::min(opt_.dt_initial, opt_.dt_max);
+  int cuts = 0;
+  const double eps = 1e-12 * std::max(1.0, opt_.t_end);
+  while (t_ < opt_.t_end - eps) {
+    // Land exactly on the next output time.
+    double next_stop = opt_.t_end;
+    for (double s : stops)
+      if (s > t_ + eps) {
+        next_stop = s;
+        break;
+      }
+    double t_new = std::min(t_ + dt, next_stop);
+    if (next_stop - t_new < 0.01 * dt) t_new = next_stop;
+    int its = 0, lits = 0;
+    std::string why;
+    if (solve_step(t_new, its, lits, why)) {
+      ++stats.steps;
+      stats.newton_its += its;
+      stats.linear_its += lits;
+      StepReport report{stats.steps, t_, dt_prev_, its, lits, cuts, assembler_.energy(u_)};
+      if (on_step) on_step(report);
+      if (its <= opt_.easy_newton_its && cuts == 0) dt = std::min(dt * opt_.grow, opt_.dt_max);
+      cuts = 0;
+    } else {
+      ++stats.step_cuts;
+      ++cuts;
+      dt = 0.5 * (t_new - t_);
+      if (dt < opt_.dt_min) {
+        std::ostringstream s;
+        s << "step " << stats.steps + 1 << " from t = " << t_ << " s: no convergence with the smallest step dt = "
+          << dt << " s after " << cuts << " cuts (" << why << ")";
+        stats.failure = s.str();
+        break;
+      }
+    }
+  }
+  stats.completed = stats.failure.empty();
+  stats.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return stats;
+}
+
+}  // namespace morphfem

@@ -1,0 +1,96 @@
+// Quasi-static solver: pseudo-time t in [0, t_end] drives every time-dependent
+// load and prescribed displacement; each step minimises the total energy with
+// Newton (PETSc SNES) and an energy-based backtracking line search that never
+// accepts a state outside the energy's domain (an inverted element) and always
+// decreases the energy. Steps adapt: a failed solve is cut and retried from the
+// last converged state, easy solves grow the step.
+//
+// Linear solver: MUMPS LU by default; "gamg" selects CG + GAMG with the rigid-body
+// near-nullspace. Any PETSc option (-snes_*, -ksp_*, -pc_*) on the command line
+// overrides these defaults.
+#pragma once
+#include <petscsnes.h>
+
+#include <array>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "fem/assembly.h"
+
+namespace morphfem {
+
+// Prescribed displacement u_i = value(X, t)_i on the given components of `nodes`.
+struct DirichletCondition {
+  std::string name;
+  std::vector<int> nodes;
+  std::array<bool, 3> components{true, true, true};
+  std::function<Eigen::Vector3d(const Eigen::Vector3d& X, double t)> value;
+};
+
+struct SolverOptions {
+  double t_end = 1.0;         // end of the pseudo-time [s]
+  double dt_initial = 0.1;    // first step [s]
+  double dt_min = 1e-6;       // smallest step before giving up [s]
+  double dt_max = 1.0;        // largest step [s]
+  double grow = 1.5;          // step growth after an easy solve
+  int easy_newton_its = 6;    // "easy": converged in at most this many iterations
+  int max_newton_its = 30;
+  double rtol = 1e-9;         // ||r|| <= rtol ||r_0|| ...
+  double atol_factor = 1e-11; // ... or ||r|| <= atol_factor * (largest ||r_0|| seen)
+  std::string linear_solver = "mumps";  // "mumps" | "gamg"
+  std::vector<double> output_times;     // steps land exactly on these times
+};
+
+struct StepReport {
+  int step = 0;        // 1-based converged step count
+  double t = 0, dt = 0;
+  int newton_its = 0;  // Newton iterations of this step
+  int linear_its = 0;
+  int cuts = 0;        // failed attempts before this step converged
+  double energy = 0;   // total energy [J]
+};
+
+struct RunStats {
+  int steps = 0, newton_its = 0, linear_its = 0, step_cuts = 0;
+  double wall_s = 0;
+  bool completed = false;
+  std::string failure;  // diagnostic if !completed
+};
+
+class QuasiStaticSolver {
+ public:
+  QuasiStaticSolver(Assembler& assembler, std::vector<DirichletCondition> bcs, SolverOptions options);
+  ~QuasiStaticSolver();
+  QuasiStaticSolver(const QuasiStaticSolver&) = delete;
+  QuasiStaticSolver& operator=(const QuasiStaticSolver&) = delete;
+
+  // Runs from the current state and time to t_end, calling on_step after each
+  // converged step. On failure (no convergence at dt_min) the solution keeps the
+  // last converged state and stats.failure says which step, time and why.
+  RunStats run(const std::function<void(const StepReport&)>& on_step = {});
+
+  Vec solution() const { return u_; }
+  double time() const { return t_; }
+  Assembler& assembler() { return assembler_; }
+
+  // PETSc callbacks (public for the C trampolines).
+  PetscErrorCode line_search(SNESLineSearch ls);
+  PetscErrorCode convergence(SNES snes, PetscInt it, PetscReal snorm, PetscReal fnorm, SNESConvergedReason* reason);
+
+ private:
+  void apply_dirichlet(Vec u, double t) const;
+  bool solve_step(double t_new, int& newton_its, int& linear_its, std::string& why);
+
+  Assembler& assembler_;
+  std::vector<DirichletCondition> bcs_;
+  SolverOptions opt_;
+  Vec u_ = nullptr, u_prev_ = nullptr, work_ = nullptr;
+  Mat H_ = nullptr;
+  SNES snes_ = nullptr;
+  double t_ = 0.0, dt_prev_ = 0.0;
+  double fnorm0_ = 0.0, fnorm_scale_ = 0.0;
+  double length_scale_ = 1.0;  // diagonal of the mesh's bounding box [m]
+};
+
+}  // namespace morphfem

@@ -1,0 +1,60 @@
+// Schedule player: plays a schedule file on the regulators of a channel map.
+//
+// Safety rules (enforced in play()):
+//  * the schedule is checked against the map's limits before any port is opened
+//    (ChannelMap::check_schedule); every command is clamped to [min_pa, max_pa]
+//    and slew-limited by ramp_limit_pa_per_s;
+//  * on an error reply, a garbled reply, a reply timeout, a disconnect that does
+//    not come back within reconnect_s, a tracking fault (measured pressure away
+//    from the command for too long: rupture, leak, stuck valve), SIGINT/SIGTERM,
+//    a user stop or the end of the schedule, every channel is vented to
+//    atmosphere before returning;
+//  * the CSV log (format: actuation/schedule.h, read_pressure_log) is flushed at
+//    least every 0.5 s wall time and at every event, so a crash loses < 1 s.
+#pragma once
+#include <iosfwd>
+#include <map>
+#include <string>
+
+#include "actuation/schedule.h"
+#include "hardware/channel_map.h"
+
+namespace morphfem::hw {
+
+// Exit codes of play() and `morphfem hw play`.
+constexpr int kExitOk = 0;
+constexpr int kExitInput = 2;        // refused before anything was sent
+constexpr int kExitFault = 3;        // device fault; all channels vented
+constexpr int kExitVentFailed = 4;   // fault and at least one channel could not be vented
+constexpr int kExitSigint = 130;
+constexpr int kExitSigterm = 143;
+
+struct PlayerOptions {
+  enum class Mode { fixed, settle, step } mode = Mode::fixed;
+  double time_scale = 1;          // schedule seconds per wall second (tests: 10)
+  double tick_s = 0.02;           // wall seconds between control ticks
+  double reply_timeout_s = 0.3;   // wall seconds to wait for a reply
+  double reconnect_s = 2.0;       // wall seconds to wait for a vanished port while playing
+  double vent_reconnect_s = 5.0;  // ... and before venting after a fault
+  double settle_timeout_s = 30;   // settle mode: schedule seconds a column may wait
+  double min_hold_s = 0;          // settle mode: minimum column time
+  double tracking_fault_pa = 15000;  // |measured - commanded| that counts as a fault ...
+  double tracking_fault_s = 1.0;     // ... when it lasts this long (schedule seconds)
+  bool dry_run = false;           // print the command stream, open no port
+  bool display = false;           // live commanded/measured line on `err`
+  std::string log_path;           // CSV log ("" = none)
+  std::map<std::string, std::string> ports;  // device name -> port path override
+  int step_fd = 0;                // step mode: a byte (Enter) advances, 'q' stops
+  bool handle_signals = true;     // install SIGINT/SIGTERM handlers during play
+  std::ostream* out = nullptr;    // dry-run command stream, summary (default std::cout)
+  std::ostream* err = nullptr;    // messages, live display (default std::cerr)
+};
+
+// Plays the schedule; returns one of the exit codes above. Throws InputError
+// (nothing sent) if the schedule or map is refused.
+int play(const Schedule& schedule, const ChannelMap& map, const PlayerOptions& options);
+
+// For tests: raise the player's stop flag as SIGINT/SIGTERM would.
+void request_stop(int signal_number);
+
+}  // namespace morphfem::hw

@@ -1,0 +1,50 @@
+// Geometry built in code with the gmsh C++ API, and import of user .msh files.
+// Every builder returns a Mesh with named regions (physical groups). Builders are
+// registered by name in one place (geometry.cpp) and read their parameters from
+// a ParamSet, so scenes pick a geometry with `geometry: {type: NAME, ...}`.
+#pragma once
+#include <functional>
+#include <map>
+#include <string>
+
+#include "core/params.h"
+#include "mesh/mesh.h"
+
+namespace morphfem {
+
+// Common parameters of every builder:
+//   mesh_size [m]   target element edge length (required)
+//   order           1 (P1, 4-node tets) or 2 (P2, 10-node tets; curved mid-nodes
+//                   on curved surfaces), default 1
+using GeometryBuilder = std::function<Mesh(const ParamSet&)>;
+
+// name -> builder; names: block, thick_cylinder, spherical_shell, cook_membrane,
+// cantilever (see geometry.cpp for each one's parameters and region names).
+const std::map<std::string, GeometryBuilder>& geometry_registry();
+
+// Builds geometry `params.string("type")`; throws InputError for an unknown type
+// or bad parameter.
+Mesh build_geometry(const ParamSet& params);
+
+// Reads a gmsh .msh (format 4.x) file: 4- or 10-node tetrahedra, physical groups
+// of dimension 3 (materials) and 2 (surfaces) give the named regions; elements of
+// other types are ignored except that mixing P1 and P2 tetrahedra is an error.
+// Throws InputError naming the file and what is wrong.
+Mesh read_msh(const std::string& path);
+
+// Writes `mesh` as a gmsh .msh 4.1 file: one discrete entity and one named physical
+// group per region, P2 nodes in gmsh order. Reading it back gives the same nodes,
+// faces and regions (cells are grouped by volume region, so with one volume region the
+// same Mesh). Throws InputError naming the file if it cannot be written.
+void write_msh(const Mesh& mesh, const std::string& path);
+
+// Lower level, shared by the builders and read_msh.
+// Initializes the gmsh API once per process (quiet, single-threaded); cheap to repeat.
+void initialize_gmsh();
+// Extracts the Mesh of the current gmsh model: its 4- or 10-node tetrahedra (all of
+// them must lie in a volume physical group), the triangles of every surface
+// physical group (stored once per group, oriented outward from their tetrahedron),
+// and the regions. Throws InputError naming `source` if the model is unusable.
+Mesh mesh_from_current_gmsh_model(const std::string& source);
+
+}  // namespace morphfem

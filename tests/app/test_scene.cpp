@@ -1,0 +1,133 @@
+// Scene files: a good scene runs; bad ones fail with file, line and key, and
+// leave no output behind.
+#include <gtest/gtest.h>
+#include <petscsys.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "app/scene.h"
+#include "app/simulation.h"
+#include "core/errors.h"
+
+using namespace morphfem;
+namespace fs = std::filesystem;
+
+namespace {
+
+const char* kGood = R"(name: cube
+geometry: {type: block, lx: 0.01, ly: 0.01, lz: 0.01, mesh_size: 0.005, order: 1}
+materials:
+  body: {model: neo_hookean, mu: 1.0e5, kappa: 1.0e6, density: 1000}
+boundary:
+  - {surface: zmin, fix: [x, y, z]}
+  - {surface: zmax, displacement: [0, 0, -0.001]}
+solver: {end_time: 1, initial_step: 0.5}
+output: {directory: OUT}
+)";
+
+struct TempScene {
+  fs::path dir;
+  fs::path file;
+  explicit TempScene(const std::string& text, const std::string& name = "scene.yaml") {
+    dir = fs::temp_directory_path() / ("morphfem_scene_test_" + std::to_string(::getpid()) + "_" +
+                                       ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    file = dir / name;
+    std::string t = text;
+    const auto pos = t.find("OUT");
+    if (pos != std::string::npos) t.replace(pos, 3, (dir / "out").string());
+    std::ofstream(file) << t;
+  }
+  ~TempScene() { fs::remove_all(dir); }
+};
+
+std::string error_of(const std::string& text) {
+  TempScene s(text);
+  try {
+    Scene scene = read_scene(s.file.string());
+    run_scene(scene, PETSC_COMM_WORLD, {true, false, {}});
+  } catch (const InputError& e) {
+    EXPECT_FALSE(fs::exists(s.dir / "out")) << "bad input left output behind";
+    EXPECT_FALSE(fs::exists(s.dir / "out.partial")) << "bad input left output behind";
+    return e.what();
+  }
+  return "";
+}
+
+std::string replace(std::string text, const std::string& from, const std::string& to) {
+  const auto pos = text.find(from);
+  EXPECT_NE(pos, std::string::npos) << from;
+  return text.replace(pos, from.size(), to);
+}
+
+}  // namespace
+
+TEST(Scene, GoodSceneRunsAndWritesResults) {
+  TempScene s(kGood);
+  Scene scene = read_scene(s.file.string());
+  auto r = run_scene(scene, PETSC_COMM_WORLD, {true, false, {}});
+  EXPECT_TRUE(r.stats.completed);
+  EXPECT_TRUE(fs::exists(s.dir / "out" / "cube.xdmf"));
+  EXPECT_TRUE(fs::exists(s.dir / "out" / "cube.h5"));
+  EXPECT_TRUE(fs::exists(s.dir / "out" / "summary.json"));
+  EXPECT_FALSE(fs::exists(s.dir / "out.partial"));
+  // Top face moved down by the prescribed 1 mm.
+  double uz = 0;
+  auto nodes = r.mesh.nodes_of_surface("zmax");
+  for (int n : nodes) uz += r.u(n, 2);
+  EXPECT_NEAR(uz / nodes.size(), -0.001, 1e-12);
+}
+
+TEST(Scene, UnknownKeyNamesFileLineAndKey) {
+  std::string e = error_of(replace(kGood, "solver: {end_time: 1", "solver: {end_tme: 1"));
+  EXPECT_NE(e.find("scene.yaml:8:"), std::string::npos) << e;
+  EXPECT_NE(e.find("end_tme"), std::string::npos) << e;
+}
+
+TEST(Scene, UnknownRegionIsNamedWithTheKnownOnes) {
+  std::string e = error_of(replace(kGood, "surface: zmin", "surface: bottom"));
+  EXPECT_NE(e.find("bottom"), std::string::npos) << e;
+  EXPECT_NE(e.find("zmin"), std::string::npos) << e;
+  EXPECT_NE(e.find("scene.yaml:6:"), std::string::npos) << e;
+}
+
+TEST(Scene, BadNumberNamesTheLine) {
+  std::string e = error_of(replace(kGood, "mu: 1.0e5", "mu: soft"));
+  EXPECT_NE(e.find("scene.yaml:4:"), std::string::npos) << e;
+}
+
+TEST(Scene, NegativeModulusIsRejected) {
+  std::string e = error_of(replace(kGood, "mu: 1.0e5", "mu: -1.0e5"));
+  EXPECT_NE(e.find("mu"), std::string::npos) << e;
+}
+
+TEST(Scene, UnknownMaterialModelListsTheKnownOnes) {
+  std::string e = error_of(replace(kGood, "model: neo_hookean", "model: rubber"));
+  EXPECT_NE(e.find("rubber"), std::string::npos) << e;
+  EXPECT_NE(e.find("yeoh"), std::string::npos) << e;
+}
+
+TEST(Scene, YamlSyntaxErrorNamesTheLine) {
+  std::string e = error_of(replace(kGood, "boundary:", "boundary: [unclosed"));
+  EXPECT_NE(e.find("scene.yaml:"), std::string::npos) << e;
+  EXPECT_NE(e.find("YAML"), std::string::npos) << e;
+}
+
+TEST(Scene, MissingMeshFileIsNamed) {
+  std::string e = error_of(replace(kGood, "geometry: {type: block, lx: 0.01, ly: 0.01, lz: 0.01, mesh_size: 0.005, order: 1}",
+                                   "mesh: {file: nowhere.msh}"));
+  EXPECT_NE(e.find("nowhere.msh"), std::string::npos) << e;
+}
+
+TEST(Scene, GravityWithoutDensityIsRejected) {
+  std::string text = replace(kGood, ", density: 1000", "");
+  text = replace(text, "solver:", "loads: {gravity: [0, 0, -9.81]}\nsolver:");
+  std::string e = error_of(text);
+  EXPECT_NE(e.find("density"), std::string::npos) << e;
+}
+
+TEST(Scene, MissingFileIsAnInputError) {
+  EXPECT_THROW(read_scene("/nonexistent/scene.yaml"), InputError);
+}

@@ -1,0 +1,421 @@
+// The player against the emulator over real pseudo-terminals: both protocols,
+// both hand-designed gaits, every injected fault, safety refusals, dry run,
+// settle and step modes, and the log replayed through the schedule reader.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <thread>
+
+#include "actuation/schedule.h"
+#include "core/errors.h"
+#include "hardware/channel_map.h"
+#include "hardware/cli.h"
+#include "hardware/emulator.h"
+#include "hardware/player.h"
+
+using namespace morphfem;
+using namespace morphfem::hw;
+
+namespace {
+
+const std::string kExamples = std::string(MORPHFEM_SOURCE_DIR) + "/examples/schedules/";
+
+std::string temp_dir(const std::string& name) {
+  std::string d = std::string(MORPHFEM_BINARY_DIR) + "/test_hw_" + name + "_" + std::to_string(getpid());
+  std::filesystem::remove_all(d);
+  std::filesystem::create_directories(d);
+  return d;
+}
+
+// Mixed map: bladders on Booth regulators, core and feet on an Alicat line.
+// all_alicat: every channel on the Alicat line (unit IDs A..K).
+std::string map_text(const std::string& dir, bool all_alicat, double bladder_max = 35000) {
+  std::ostringstream m;
+  m << "morphfem_channel_map: 1\ndevices:\n"
+    << "  bus: {protocol: alicat, port: " << dir << "/bus}\n";
+  if (!all_alicat) m << "  bridge: {protocol: booth, port: " << dir << "/bridge, half_band_pa: 300}\n";
+  m << "channels:\n";
+  for (int b = 0; b < 8; ++b) {
+    m << "  b" << b + 1 << ": {device: " << (all_alicat ? "bus" : "bridge") << ", address: ";
+    if (all_alicat) m << char('D' + b);
+    else m << "0x" << std::hex << 0x11 + b << std::dec;
+    m << ", min_pa: -5000, max_pa: " << bladder_max << "}\n";
+  }
+  m << "  core: {device: bus, address: A, inflated_pa: 30000, min_pa: -85000, max_pa: 55000}\n"
+    << "  foot_a: {device: bus, address: B, min_pa: -85000, max_pa: 55000}\n"
+    << "  foot_b: {device: bus, address: C, min_pa: -85000, max_pa: 55000}\n";
+  return m.str();
+}
+
+struct Rig {
+  std::string dir;
+  ChannelMap map;
+  std::unique_ptr<Emulator> emu;
+  PlayerOptions opt;
+  std::ostringstream out, err;
+
+  Rig(const std::string& name, bool all_alicat, EmulatorConfig cfg = {}) {
+    dir = temp_dir(name);
+    map = parse_channel_map(map_text(dir, all_alicat), dir + "/map.yaml");
+    cfg.time_scale = 10;
+    cfg.seed = 7;
+    cfg.links = {{"bus", dir + "/bus"}, {"bridge", dir + "/bridge"}};
+    emu = std::make_unique<Emulator>(map, cfg);
+    emu->start();
+    opt.time_scale = 10;
+    opt.tick_s = 0.02;
+    opt.reply_timeout_s = 1.0;
+    opt.log_path = dir + "/log.csv";
+    opt.handle_signals = false;
+    opt.out = &out;
+    opt.err = &err;
+  }
+  ~Rig() {
+    emu->stop();
+    std::filesystem::remove_all(dir);
+  }
+  int play(const Schedule& s) { return hw::play(s, map, opt); }
+};
+
+// Measured pressures at the last sample of every column match the commands within tol.
+void expect_tracking(const PressureTrace& tr, const Schedule& s, double tol) {
+  int checked = 0;
+  for (int k = 0; k < s.total_columns(); ++k) {
+    std::size_t last = tr.t.size();
+    for (std::size_t i = 0; i < tr.t.size(); ++i)
+      if (tr.column[i] == k) last = i;
+    if (last == tr.t.size()) continue;
+    ++checked;
+    for (std::size_t c = 0; c < tr.channels.size(); ++c)
+      EXPECT_NEAR(tr.measured[c][last], tr.commanded[c][last], tol)
+          << channel_name(tr.channels[c]) << " column " << k + 1 << " t " << tr.t[last];
+  }
+  EXPECT_GE(checked, s.total_columns() - 1);
+}
+
+std::string last_event(const PressureTrace& tr) { return tr.events.empty() ? "" : tr.events.back().message; }
+
+bool has_fault(const PressureTrace& tr, const std::string& text) {
+  for (auto& e : tr.events)
+    if (e.kind == "fault" && e.message.find(text) != std::string::npos) return true;
+  return false;
+}
+
+}  // namespace
+
+TEST(ChannelMapFile, ExampleParsesAndAcceptsTheGaits) {
+  ChannelMap m = read_channel_map(kExamples + "channel_map.yaml");
+  EXPECT_EQ(m.devices.size(), 2u);
+  EXPECT_EQ(m.channels.size(), 11u);
+  EXPECT_EQ(m.find(0)->address, 0x11);
+  EXPECT_EQ(m.find(kChannelCore)->address, 'A');
+  m.check_schedule(read_schedule(kExamples + "rolling.yaml"));
+  m.check_schedule(read_schedule(kExamples + "inching.yaml"));
+  auto lv = m.effective_levels(read_schedule(kExamples + "rolling.yaml"));
+  EXPECT_EQ(lv[kChannelCore].inflate_pa, 50000);
+}
+
+TEST(ChannelMapFile, ErrorsNameFileLineAndReason) {
+  auto err = [](const std::string& text) {
+    try {
+      parse_channel_map(text, "map.yaml");
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  std::string head = "morphfem_channel_map: 1\ndevices:\n  bus: {protocol: alicat, port: /dev/null}\nchannels:\n";
+  std::string e = err(head + "  b1: {device: bus, address: AB, min_pa: 0, max_pa: 1}\n");
+  EXPECT_NE(e.find("map.yaml:5:"), std::string::npos) << e;
+  EXPECT_NE(e.find("channels.b1.address"), std::string::npos) << e;
+  e = err(head + "  b1: {device: bus, address: A, min_pa: 0}\n");
+  EXPECT_NE(e.find("max_pa"), std::string::npos) << e;
+  e = err(head + "  b9: {device: bus, address: A, min_pa: 0, max_pa: 1}\n");
+  EXPECT_NE(e.find("unknown channel 'b9'"), std::string::npos) << e;
+  e = err(head + "  b1: {device: bus, address: A, min_pa: 0, max_pa: 1}\n  b2: {device: bus, address: A, min_pa: 0, max_pa: 1}\n");
+  EXPECT_NE(e.find("map.yaml:6:"), std::string::npos) << e;
+  EXPECT_NE(e.find("already used"), std::string::npos) << e;
+  e = err(head + "  b1: {device: bus, address: A, min_pa: 0, max_pa: 100, inflated_pa: 200}\n");
+  EXPECT_NE(e.find("outside this channel's limits"), std::string::npos) << e;
+  e = err(head + "  b1: {device: nope, address: A, min_pa: 0, max_pa: 1}\n");
+  EXPECT_NE(e.find("no device named 'nope'"), std::string::npos) << e;
+  e = err("morphfem_channel_map: 1\ndevices:\n  bus: {protocol: can}\nchannels: {}\n");
+  EXPECT_NE(e.find("map.yaml:3:"), std::string::npos) << e;
+  EXPECT_NE(e.find("unknown protocol 'can'"), std::string::npos) << e;
+}
+
+TEST(Player, RefusesPressuresBeyondLimitsBeforeSendingAnything) {
+  std::string dir = temp_dir("refuse");
+  // Bladder limit below the schedule's 25 kPa inflate level.
+  ChannelMap m = parse_channel_map(map_text(dir, true, 20000), dir + "/map.yaml");
+  EmulatorConfig cfg;
+  cfg.links = {{"bus", dir + "/bus"}};
+  Emulator emu(m, cfg);
+  emu.start();
+  PlayerOptions opt;
+  std::ostringstream sink;
+  opt.out = opt.err = &sink;
+  opt.handle_signals = false;
+  opt.log_path = dir + "/log.csv";
+  try {
+    play(read_schedule(kExamples + "rolling.yaml"), m, opt);
+    ADD_FAILURE() << "schedule beyond limits was accepted";
+  } catch (const InputError& e) {
+    std::string w = e.what();
+    EXPECT_NE(w.find("refused before sending anything"), std::string::npos) << w;
+    EXPECT_NE(w.find("25000"), std::string::npos) << w;
+    EXPECT_NE(w.find("channels.b1"), std::string::npos) << w;
+  }
+  EXPECT_EQ(emu.requests(), 0);
+  EXPECT_FALSE(std::filesystem::exists(dir + "/log.csv"));
+  // A map level beyond the channel's own limit is refused when the map is read.
+  EXPECT_THROW(parse_channel_map("morphfem_channel_map: 1\ndevices:\n  bus: {protocol: alicat}\nchannels:\n"
+                                 "  b1: {device: bus, address: A, min_pa: 0, max_pa: 30000, inflated_pa: 40000}\n",
+                                 "m.yaml"),
+               InputError);
+  // Through the CLI: exit code 2, message names the file.
+  std::ofstream(dir + "/map.yaml") << map_text(dir, true, 20000);
+  EXPECT_EQ(hardware_main({"check", kExamples + "rolling.yaml", "--map", dir + "/map.yaml"}), kExitInput);
+  emu.stop();
+  std::filesystem::remove_all(dir);
+}
+
+TEST(Player, DryRunPrintsTheCommandStream) {
+  ChannelMap m = read_channel_map(kExamples + "channel_map.yaml");
+  PlayerOptions opt;
+  std::ostringstream out, err;
+  opt.out = &out;
+  opt.err = &err;
+  opt.dry_run = true;
+  opt.handle_signals = false;
+  ASSERT_EQ(play(read_schedule(kExamples + "rolling.yaml"), m, opt), kExitOk);
+  std::string s = out.str();
+  // b8 inflates in column 1 (ramp-limited to 500 kPa/s by the map): setpoint counts
+  // for 25 kPa = 1023*(0.1+0.8*0.625) = 614 -> left-justified 0x9980.
+  EXPECT_NE(s.find("t=0.000 b8 bridge tx A5 57 18 10 03 80 00 01"), std::string::npos) << s.substr(0, 2000);
+  EXPECT_NE(s.find("t=0.200 b8 bridge tx A5 57 18 10 03 99 80 01"), std::string::npos) << s.substr(0, 2000);
+  EXPECT_NE(s.find("core alicat tx AS 50.000\\r"), std::string::npos);
+  EXPECT_NE(s.find("vent foot_b alicat tx CS 0.000\\r"), std::string::npos);
+  EXPECT_TRUE(err.str().empty()) << err.str();
+}
+
+class GaitTest : public ::testing::TestWithParam<std::tuple<std::string, bool>> {};
+
+TEST_P(GaitTest, PlaysAgainstTheEmulatorAndTracks) {
+  auto [gait, all_alicat] = GetParam();
+  Rig rig(gait + (all_alicat ? "_alicat" : "_mixed"), all_alicat);
+  Schedule s = read_schedule(kExamples + gait + ".yaml");
+  auto t0 = std::chrono::steady_clock::now();
+  int code = rig.play(s);
+  double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  ASSERT_EQ(code, kExitOk) << rig.err.str();
+  EXPECT_LT(wall, 8.0);  // 19.8 s schedule at time scale 10
+  EXPECT_TRUE(rig.emu->all_vented());
+  for (auto& c : rig.emu->snapshot()) {
+    EXPECT_FALSE(c.ruptured) << channel_name(c.channel);
+    EXPECT_LE(c.max_pressure_pa, 55000 + 1000) << channel_name(c.channel);
+  }
+  PressureTrace tr = read_pressure_log(rig.opt.log_path);
+  EXPECT_EQ(tr.channels.size(), 11u);
+  EXPECT_NEAR(tr.duration(), s.duration(), 0.5);
+  expect_tracking(tr, s, 2500);
+  EXPECT_EQ(last_event(tr), "all channels vented");
+  // Real-to-sim replay: the log's commands give back the schedule's matrix.
+  ScheduleMatrix m = tr.to_matrix(s.column_s, s.columns(), rig.map.effective_levels(s));
+  EXPECT_EQ(m, s.matrix);
+  // The core held the map's pressure during the gait.
+  EXPECT_NEAR(tr.measured_at(kChannelCore, 10.0), 30000, 1500);
+}
+
+INSTANTIATE_TEST_SUITE_P(BothProtocols, GaitTest,
+                         ::testing::Combine(::testing::Values("rolling", "inching"), ::testing::Bool()));
+
+TEST(Player, SettleModeAdvancesWhenPressuresSettle) {
+  Rig rig("settle", false);
+  Schedule s = read_schedule(kExamples + "inching.yaml");
+  s.repeats = 1;
+  rig.opt.mode = PlayerOptions::Mode::settle;
+  ASSERT_EQ(rig.play(s), kExitOk) << rig.err.str();
+  PressureTrace tr = read_pressure_log(rig.opt.log_path);
+  int settled = 0;
+  for (auto& e : tr.events) settled += e.message.rfind("settled", 0) == 0;
+  EXPECT_EQ(settled, 9);                    // rest + 8 columns
+  EXPECT_LT(tr.duration(), s.duration());  // faster than fixed 1.237 s columns
+  EXPECT_TRUE(rig.emu->all_vented());
+}
+
+TEST(Player, StepModeWaitsForKeys) {
+  Rig rig("step", true);
+  Schedule s = read_schedule(kExamples + "rolling.yaml");
+  s.repeats = 1;
+  int fds[2];
+  ASSERT_EQ(pipe(fds), 0);
+  rig.opt.mode = PlayerOptions::Mode::step;
+  rig.opt.step_fd = fds[0];
+  std::thread keys([&] {
+    for (int i = 0; i < 3; ++i) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+      ASSERT_EQ(write(fds[1], "\n", 1), 1);
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    ASSERT_EQ(write(fds[1], "q", 1), 1);
+  });
+  int code = rig.play(s);
+  keys.join();
+  close(fds[0]);
+  close(fds[1]);
+  EXPECT_EQ(code, kExitOk) << rig.err.str();
+  PressureTrace tr = read_pressure_log(rig.opt.log_path);
+  int steps = 0;
+  for (auto& e : tr.events) steps += e.message.rfind("step to column", 0) == 0;
+  EXPECT_EQ(steps, 3);
+  EXPECT_EQ(tr.column.back(), 2);
+  EXPECT_TRUE(rig.emu->all_vented());
+}
+
+TEST(Player, ReconnectsWhenThePortComesBack) {
+  EmulatorConfig cfg;
+  cfg.faults.push_back(parse_fault("disconnect@5:0.3"));  // back after 0.3 s wall
+  Rig rig("reconnect", false, cfg);
+  rig.opt.reconnect_s = 5;
+  Schedule s = read_schedule(kExamples + "rolling.yaml");
+  s.repeats = 1;
+  ASSERT_EQ(rig.play(s), kExitOk) << rig.err.str();
+  PressureTrace tr = read_pressure_log(rig.opt.log_path);
+  bool lost = false, back = false;
+  for (auto& e : tr.events) {
+    lost |= e.message.find("lost") != std::string::npos;
+    back |= e.message.find("reconnected") != std::string::npos;
+  }
+  EXPECT_TRUE(lost && back);
+  EXPECT_TRUE(rig.emu->all_vented());
+}
+
+// ---- One test per injected fault: vented, clear message, non-zero exit, log complete.
+
+void expect_fault_handled(Rig& rig, int code, int expect_code, const std::string& text) {
+  EXPECT_EQ(code, expect_code) << rig.err.str();
+  EXPECT_NE(rig.err.str().find(text), std::string::npos) << rig.err.str();
+  EXPECT_NE(rig.err.str().find("all channels vented"), std::string::npos) << rig.err.str();
+  EXPECT_TRUE(rig.emu->all_vented());
+  PressureTrace tr = read_pressure_log(rig.opt.log_path);
+  EXPECT_TRUE(has_fault(tr, text)) << text;
+  EXPECT_EQ(last_event(tr), "all channels vented");
+  EXPECT_GT(tr.t.size(), 5u);  // samples up to the fault
+}
+
+TEST(PlayerFault, GarbledReply) {
+  EmulatorConfig cfg;
+  cfg.faults.push_back(parse_fault("garble@3"));
+  Rig rig("garble", false, cfg);
+  int code = rig.play(read_schedule(kExamples + "rolling.yaml"));
+  expect_fault_handled(rig, code, kExitFault, "garbled reply");
+}
+
+TEST(PlayerFault, NoReply) {
+  EmulatorConfig cfg;
+  cfg.faults.push_back(parse_fault("silence@3:3"));  // 0.3 s wall of silence
+  Rig rig("silence", true, cfg);
+  rig.opt.reply_timeout_s = 0.5;
+  int code = rig.play(read_schedule(kExamples + "inching.yaml"));
+  expect_fault_handled(rig, code, kExitFault, "reply timeout");
+}
+
+TEST(PlayerFault, TruncatedReply) {
+  EmulatorConfig cfg;
+  cfg.faults.push_back(parse_fault("drop@3"));
+  Rig rig("drop", false, cfg);
+  rig.opt.reply_timeout_s = 0.3;
+  int code = rig.play(read_schedule(kExamples + "rolling.yaml"));
+  EXPECT_EQ(code, kExitFault);
+  EXPECT_TRUE(rig.emu->all_vented());
+}
+
+TEST(PlayerFault, Disconnect) {
+  EmulatorConfig cfg;
+  cfg.faults.push_back(parse_fault("disconnect@3:1.0"));  // returns after 1 s wall, too late
+  Rig rig("disconnect", false, cfg);
+  rig.opt.reconnect_s = 0.2;
+  rig.opt.vent_reconnect_s = 10;
+  int code = rig.play(read_schedule(kExamples + "rolling.yaml"));
+  expect_fault_handled(rig, code, kExitFault, "device disconnected");
+}
+
+TEST(PlayerFault, PermanentDisconnectCannotVent) {
+  EmulatorConfig cfg;
+  cfg.faults.push_back(parse_fault("disconnect@3"));
+  Rig rig("gone", true, cfg);
+  rig.opt.reconnect_s = 0.2;
+  rig.opt.vent_reconnect_s = 0.2;
+  int code = rig.play(read_schedule(kExamples + "rolling.yaml"));
+  EXPECT_EQ(code, kExitVentFailed);
+  EXPECT_NE(rig.err.str().find("COULD NOT VENT"), std::string::npos) << rig.err.str();
+}
+
+TEST(PlayerFault, Rupture) {
+  EmulatorConfig cfg;
+  cfg.rupture_pa = 20000;  // below the 25 kPa the gait asks for
+  Rig rig("rupture", false, cfg);
+  int code = rig.play(read_schedule(kExamples + "rolling.yaml"));
+  // b8 ruptures first (column 1) but its column ends before the 1 s fault delay;
+  // b7 or b6, inflated next, also rupture, and the player stops there.
+  expect_fault_handled(rig, code, kExitFault, "tracking fault on b");
+  EXPECT_NE(rig.err.str().find("ruptured bladder"), std::string::npos);
+  EXPECT_TRUE(rig.emu->channel(7).ruptured);
+}
+
+TEST(PlayerFault, StuckValve) {
+  EmulatorConfig cfg;
+  // b1 is inflated in column 8 (8.66-9.90 s); its valve sticks closed at 9.3 s,
+  // so it stays inflated when column 9 asks for 0 kPa.
+  cfg.faults.push_back(parse_fault("stuck@9.3:b1"));
+  Rig rig("stuck", true, cfg);
+  int code = rig.play(read_schedule(kExamples + "rolling.yaml"));
+  EXPECT_TRUE(rig.emu->channel(0).stuck);
+  EXPECT_EQ(code, kExitFault) << rig.err.str();
+  EXPECT_NE(rig.err.str().find("tracking fault on b1"), std::string::npos) << rig.err.str();
+  PressureTrace tr = read_pressure_log(rig.opt.log_path);
+  EXPECT_TRUE(has_fault(tr, "tracking fault on b1"));
+  EXPECT_EQ(last_event(tr), "all channels vented");  // every vent command was acknowledged
+}
+
+TEST(PlayerFault, Sigint) {
+  Rig rig("sigint", false);
+  rig.opt.handle_signals = true;
+  int code = -1;
+  std::thread player([&] { code = rig.play(read_schedule(kExamples + "rolling.yaml")); });
+  auto t0 = std::chrono::steady_clock::now();
+  while (rig.emu->requests() < 400 && std::chrono::steady_clock::now() - t0 < std::chrono::seconds(20))
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  kill(getpid(), SIGINT);
+  player.join();
+  expect_fault_handled(rig, code, kExitSigint, "stopped by SIGINT");
+}
+
+TEST(PlayerFault, ErrorReplyFromMissingUnit) {
+  // The map names an I2C address no regulator answers: NACK at start-up.
+  std::string dir = temp_dir("nack");
+  ChannelMap real = parse_channel_map(map_text(dir, false), dir + "/map.yaml");
+  std::string text = map_text(dir, false);
+  text.replace(text.find("0x18"), 4, "0x30");
+  ChannelMap wrong = parse_channel_map(text, dir + "/map.yaml");
+  EmulatorConfig cfg;
+  cfg.links = {{"bus", dir + "/bus"}, {"bridge", dir + "/bridge"}};
+  Emulator emu(real, cfg);
+  emu.start();
+  PlayerOptions opt;
+  std::ostringstream sink;
+  opt.out = opt.err = &sink;
+  opt.handle_signals = false;
+  opt.reply_timeout_s = 1.0;
+  EXPECT_EQ(play(read_schedule(kExamples + "rolling.yaml"), wrong, opt), kExitVentFailed);
+  EXPECT_NE(sink.str().find("no regulator at this address"), std::string::npos) << sink.str();
+  emu.stop();
+  std::filesystem::remove_all(dir);
+}
