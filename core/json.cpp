@@ -80,11 +80,18 @@ std::string Json::str(bool pretty, int indent) const {
   std::string s = "{";
   for (size_t i = 0; i < fields_.size(); ++i) {
     if (i) s += ",";
-    if (pretty) s += "\n" + pad;
-    else if (i) s += " ";
+    if (pretty) {
+      s += '\n';
+      s += pad;
+    } else if (i) {
+      s += ' ';
+    }
     s += json_string(fields_[i].first) + ": " + fields_[i].second;
   }
-  if (pretty && !fields_.empty()) s += "\n" + std::string(indent, ' ');
+  if (pretty && !fields_.empty()) {
+    s += '\n';
+    s.append(indent, ' ');
+  }
   return s + "}";
 }
 

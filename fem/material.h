@@ -41,7 +41,10 @@ using MaterialFactory = std::function<std::unique_ptr<Material>(const ParamSet&)
 // name -> factory. Names: neo_hookean (mu, kappa), mooney_rivlin (c10, c01, kappa),
 // yeoh (c1, c2, c3, kappa), ogden (mu: [..], alpha: [..], kappa). Presets
 // dragon_skin_10 and dragon_skin_30 take optional kappa. The bulk modulus may be
-// given as kappa [Pa] or as Poisson's ratio nu.
+// given as kappa [Pa] or as Poisson's ratio nu (one of them is required, except for
+// the presets, which default to nu = 0.49). Presets also take `law: yeoh`
+// (default) or `law: neo_hookean`; their coefficients are fits to the tensile data
+// in shared/data/materials over <= 200 % strain (see fem/material.cpp).
 const std::map<std::string, MaterialFactory>& material_registry();
 
 // Builds `params.string("model")`; unknown names and bad parameters throw InputError.

@@ -204,10 +204,21 @@ ChannelMap parse_channel_map(const std::string& text, const std::string& source)
       r.fail(n["min_pa"], key + ".min_pa", "limits must include 0 Pa (venting to atmosphere)");
     if (n["inflated_pa"]) c.inflated_pa = r.number(n["inflated_pa"], key + ".inflated_pa");
     if (n["deflated_pa"]) c.deflated_pa = r.number(n["deflated_pa"], key + ".deflated_pa");
-    for (auto [opt, k] : {std::pair{c.inflated_pa, "inflated_pa"}, std::pair{c.deflated_pa, "deflated_pa"}})
-      if (opt && (*opt < c.min_pa || *opt > c.max_pa))
-        r.fail(n[k], key + "." + k,
-               fmt(*opt) + " Pa is outside this channel's limits [" + fmt(c.min_pa) + ", " + fmt(c.max_pa) + "] Pa");
+    auto within = [&](const std::optional<double>& v, const char* k) {
+      if (!v || (*v >= c.min_pa && *v <= c.max_pa)) return;
+      std::string what = fmt(*v);
+      what += " Pa is outside this channel's limits [";
+      what += fmt(c.min_pa);
+      what += ", ";
+      what += fmt(c.max_pa);
+      what += "] Pa";
+      std::string full_key = key;
+      full_key += '.';
+      full_key += k;
+      r.fail(n[k], full_key, what);
+    };
+    within(c.inflated_pa, "inflated_pa");
+    within(c.deflated_pa, "deflated_pa");
     if (n["ramp_limit_pa_per_s"]) {
       c.ramp_limit_pa_per_s = r.number(n["ramp_limit_pa_per_s"], key + ".ramp_limit_pa_per_s");
       if (c.ramp_limit_pa_per_s <= 0) r.fail(n["ramp_limit_pa_per_s"], key + ".ramp_limit_pa_per_s", "must be positive");

@@ -538,13 +538,15 @@ int play(const Schedule& schedule, const ChannelMap& map, const PlayerOptions& o
                                                  : hex_bytes(r.booth_setpoint_request(0, booth::kStateVent)))
           << "\n";
   } else {
+    const double vent_deadline = wall_s() + opt.vent_reconnect_s;
     for (auto& r : regs) {
       bool ok = false;
       for (int attempt = 0; attempt < 3 && !ok; ++attempt) {
         try {
           if (!r.line->port || !r.line->port->is_open()) {
             if (!r.line->port) r.line->port = std::make_unique<SerialPort>(r.line->path, r.line->baud);
-            if (!r.line->port->reconnect(attempt == 0 ? opt.vent_reconnect_s : 0.2)) continue;
+            // Wait for a vanished port, for vent_reconnect_s in total over all channels.
+            if (!r.line->port->reconnect(std::max(0.05, vent_deadline - wall_s()))) continue;
           }
           r.vent(io_timeout);
           ok = true;

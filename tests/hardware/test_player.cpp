@@ -9,6 +9,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <sstream>
 #include <thread>
 
@@ -181,7 +182,17 @@ TEST(Player, RefusesPressuresBeyondLimitsBeforeSendingAnything) {
                InputError);
   // Through the CLI: exit code 2, message names the file.
   std::ofstream(dir + "/map.yaml") << map_text(dir, true, 20000);
-  EXPECT_EQ(hardware_main({"check", kExamples + "rolling.yaml", "--map", dir + "/map.yaml"}), kExitInput);
+  std::ostringstream cli_out, cli_err;
+  auto* old_out = std::cout.rdbuf(cli_out.rdbuf());
+  auto* old_err = std::cerr.rdbuf(cli_err.rdbuf());
+  int cli_code = hardware_main({"check", kExamples + "rolling.yaml", "--map", dir + "/map.yaml"});
+  int ok_code = hardware_main({"check", kExamples + "inching.yaml", "--map", kExamples + "channel_map.yaml"});
+  std::cout.rdbuf(old_out);
+  std::cerr.rdbuf(old_err);
+  EXPECT_EQ(cli_code, kExitInput);
+  EXPECT_NE(cli_err.str().find(dir + "/map.yaml:"), std::string::npos) << cli_err.str();
+  EXPECT_EQ(ok_code, 0) << cli_err.str();
+  EXPECT_NE(cli_out.str().find("every pressure within limits"), std::string::npos);
   emu.stop();
   std::filesystem::remove_all(dir);
 }
