@@ -4,6 +4,8 @@
 // piece's reference and current nodal positions to an energy [J], its gradient
 // [N] and Hessian [N/m]. One assembly loop (fem/assembly.cpp) serves every term.
 #pragma once
+#include <petscvec.h>
+
 #include <Eigen/Dense>
 #include <string>
 #include <vector>
@@ -39,6 +41,28 @@ class EnergyTerm {
   // this rank's nodes, for terms that need a global reduction first (cavity
   // volumes of gas-filled cavities). Default: nothing.
   virtual void prepare(const class Assembler& /*assembler*/, const std::vector<double>& /*u_local*/) {}
+
+  // Step life cycle (time stepping, lagged quantities). begin_step is called
+  // before every attempt of the step t0 -> t1 with the converged state u0 at t0
+  // (again after a step cut); end_step once the step converged with u1. Terms
+  // keep history (velocities, lagged normal forces, gas amounts) here.
+  virtual void begin_step(class Assembler& /*assembler*/, Vec /*u0*/, double /*t0*/, double /*t1*/) {}
+  virtual void end_step(class Assembler& /*assembler*/, Vec /*u1*/, double /*t1*/) {}
+
+  // Largest fraction alpha in (0, 1] such that u + alpha du stays admissible for
+  // this term (e.g. no node crosses a contact barrier). Collective. Default 1.
+  virtual double max_step(class Assembler& /*assembler*/, Vec /*u*/, Vec /*du*/) { return 1.0; }
+
+  // Dense low-rank Hessian parts that would fill the sparse matrix, e.g. the gas
+  // stiffness (nRT/V^2) dV dV^T of a gas-filled cavity: H += sum_j c_j v_j v_j^T.
+  // The term creates the vectors (assembled global vectors, zero on constrained
+  // dofs, from assembler.create_vector()); the caller destroys them. Collective.
+  struct LowRank {
+    Vec v;
+    double c;
+  };
+  virtual bool has_low_rank() const { return false; }
+  virtual void low_rank(class Assembler& /*assembler*/, Vec /*u*/, std::vector<LowRank>& /*out*/) {}
 };
 
 }  // namespace morphfem

@@ -24,17 +24,13 @@ PetscErrorCode form_function(SNES snes, Vec u, Vec r, void* ctx) {
 }
 
 PetscErrorCode form_jacobian(SNES, Vec u, Mat J, Mat P, void* ctx) {
-  auto* self = static_cast<QuasiStaticSolver*>(ctx);
-  try {
-    self->assembler().hessian(u, P);
-  } catch (const std::exception& ex) {
-    SETERRQ(PETSC_COMM_SELF, PETSC_ERR_LIB, "%s", ex.what());
-  }
-  if (J != P) {
-    PetscCall(MatAssemblyBegin(J, MAT_FINAL_ASSEMBLY));
-    PetscCall(MatAssemblyEnd(J, MAT_FINAL_ASSEMBLY));
-  }
-  return 0;
+  return static_cast<QuasiStaticSolver*>(ctx)->jacobian(u, J, P);
+}
+
+PetscErrorCode shell_mult(Mat J, Vec x, Vec y) {
+  void* ctx;
+  PetscCall(MatShellGetContext(J, &ctx));
+  return static_cast<QuasiStaticSolver*>(ctx)->operator_mult(x, y);
 }
 
 PetscErrorCode form_objective(SNES, Vec u, PetscReal* e, void* ctx) {
@@ -72,7 +68,18 @@ QuasiStaticSolver::QuasiStaticSolver(Assembler& assembler, std::vector<Dirichlet
   PETSC_CHECK(SNESCreate(assembler_.comm(), &snes_));
   PETSC_CHECK(SNESSetType(snes_, SNESNEWTONLS));
   PETSC_CHECK(SNESSetFunction(snes_, work_, form_function, this));
-  PETSC_CHECK(SNESSetJacobian(snes_, H_, H_, form_jacobian, this));
+  bool any_low_rank = false;
+  for (const auto& term : assembler_.terms()) any_low_rank = any_low_rank || term->has_low_rank();
+  if (any_low_rank) {
+    // Dense low-rank Hessian parts stay out of the sparse matrix: the Newton
+    // operator is a shell H + sum c v v^T, preconditioned by (a factorisation of) H.
+    const PetscInt n_local = assembler_.owned_dof_end() - assembler_.owned_dof_begin();
+    PETSC_CHECK(MatCreateShell(assembler_.comm(), n_local, n_local, assembler_.n_dofs(), assembler_.n_dofs(), this, &J_));
+    PETSC_CHECK(MatShellSetOperation(J_, MATOP_MULT, (void (*)(void))shell_mult));
+    PETSC_CHECK(SNESSetJacobian(snes_, J_, H_, form_jacobian, this));
+  } else {
+    PETSC_CHECK(SNESSetJacobian(snes_, H_, H_, form_jacobian, this));
+  }
   PETSC_CHECK(SNESSetObjective(snes_, form_objective, this));
   PETSC_CHECK(SNESSetConvergenceTest(snes_, convergence_trampoline, this, nullptr));
   PETSC_CHECK(SNESSetTolerances(snes_, 0.0, 0.0, 0.0, opt_.max_newton_its, 100000));
@@ -86,11 +93,12 @@ QuasiStaticSolver::QuasiStaticSolver(Assembler& assembler, std::vector<Dirichlet
   PETSC_CHECK(SNESGetKSP(snes_, &ksp));
   PETSC_CHECK(KSPGetPC(ksp, &pc));
   if (opt_.linear_solver == "mumps") {
-    PETSC_CHECK(KSPSetType(ksp, KSPPREONLY));
+    PETSC_CHECK(KSPSetType(ksp, J_ ? KSPGMRES : KSPPREONLY));
+    if (J_) PETSC_CHECK(KSPSetTolerances(ksp, 1e-12, 1e-50, PETSC_DEFAULT, 100));
     PETSC_CHECK(PCSetType(pc, PCLU));
     PETSC_CHECK(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
   } else if (opt_.linear_solver == "gamg") {
-    PETSC_CHECK(KSPSetType(ksp, KSPCG));
+    PETSC_CHECK(KSPSetType(ksp, J_ ? KSPGMRES : KSPCG));
     PETSC_CHECK(PCSetType(pc, PCGAMG));
     PETSC_CHECK(KSPSetTolerances(ksp, 1e-10, 1e-50, PETSC_DEFAULT, 2000));
     // Rigid-body modes from the reference coordinates of the owned nodes.
@@ -110,11 +118,45 @@ QuasiStaticSolver::QuasiStaticSolver(Assembler& assembler, std::vector<Dirichlet
 }
 
 QuasiStaticSolver::~QuasiStaticSolver() {
+  clear_low_rank();
   SNESDestroy(&snes_);
+  if (J_) MatDestroy(&J_);
   MatDestroy(&H_);
   VecDestroy(&u_);
   VecDestroy(&u_prev_);
   VecDestroy(&work_);
+}
+
+void QuasiStaticSolver::clear_low_rank() {
+  for (auto& lr : low_rank_) VecDestroy(&lr.v);
+  low_rank_.clear();
+}
+
+PetscErrorCode QuasiStaticSolver::jacobian(Vec u, Mat J, Mat P) {
+  try {
+    assembler_.hessian(u, P);
+    if (J_) {
+      clear_low_rank();
+      for (const auto& term : assembler_.terms()) term->low_rank(assembler_, u, low_rank_);
+    }
+  } catch (const std::exception& ex) {
+    SETERRQ(PETSC_COMM_SELF, PETSC_ERR_LIB, "%s", ex.what());
+  }
+  if (J != P) {
+    PetscCall(MatAssemblyBegin(J, MAT_FINAL_ASSEMBLY));
+    PetscCall(MatAssemblyEnd(J, MAT_FINAL_ASSEMBLY));
+  }
+  return 0;
+}
+
+PetscErrorCode QuasiStaticSolver::operator_mult(Vec x, Vec y) {
+  PetscCall(MatMult(H_, x, y));
+  for (const auto& lr : low_rank_) {
+    PetscScalar dot;
+    PetscCall(VecDot(lr.v, x, &dot));
+    PetscCall(VecAXPY(y, lr.c * dot, lr.v));
+  }
+  return 0;
 }
 
 void QuasiStaticSolver::apply_dirichlet(Vec u, double t) const {
@@ -154,7 +196,15 @@ PetscErrorCode QuasiStaticSolver::line_search(SNESLineSearch ls) {
   }
   PetscReal fnorm_old;
   PetscCall(VecNorm(F, NORM_2, &fnorm_old));
+  // Largest admissible step along du = -Y (contact barriers, ...).
   double lambda = 1.0;
+  PetscCall(VecCopy(Y, W));
+  PetscCall(VecScale(W, -1.0));
+  for (const auto& term : assembler_.terms()) lambda = std::min(lambda, term->max_step(assembler_, X, W));
+  if (!(lambda > 0)) {
+    PetscCall(SNESLineSearchSetReason(ls, SNES_LINESEARCH_FAILED_DOMAIN));
+    return 0;
+  }
   bool accepted = false;
   for (int attempt = 0; attempt < 40 && !accepted; ++attempt, lambda *= 0.5) {
     PetscCall(VecWAXPY(W, -lambda, Y, X));
@@ -218,7 +268,10 @@ bool QuasiStaticSolver::solve_step(double t_new, int& newton_its, int& linear_it
     PETSC_CHECK(VecAXPY(work_, dt / dt_prev_, u_));
     PETSC_CHECK(VecAXPY(work_, -dt / dt_prev_, u_prev_));
   }
-  for (const auto& term : assembler_.terms()) term->set_time(t_new);
+  for (const auto& term : assembler_.terms()) {
+    term->set_time(t_new);
+    term->begin_step(assembler_, u_, t_, t_new);
+  }
   apply_dirichlet(work_, t_new);
   if (!std::isfinite(assembler_.energy(work_))) {
     PETSC_CHECK(VecCopy(u_, work_));
@@ -245,6 +298,7 @@ bool QuasiStaticSolver::solve_step(double t_new, int& newton_its, int& linear_it
   if (ok) {
     PETSC_CHECK(VecCopy(u_, u_prev_));
     PETSC_CHECK(VecCopy(x, u_));
+    for (const auto& term : assembler_.terms()) term->end_step(assembler_, u_, t_new);
     dt_prev_ = dt;
     t_ = t_new;
   } else {

@@ -77,6 +77,8 @@ class QuasiStaticSolver {
   // PETSc callbacks (public for the C trampolines).
   PetscErrorCode line_search(SNESLineSearch ls);
   PetscErrorCode convergence(SNES snes, PetscInt it, PetscReal snorm, PetscReal fnorm, SNESConvergedReason* reason);
+  PetscErrorCode jacobian(Vec u, Mat J, Mat P);
+  PetscErrorCode operator_mult(Vec x, Vec y);  // (H + sum c v v^T) x
 
  private:
   void apply_dirichlet(Vec u, double t) const;
@@ -87,6 +89,9 @@ class QuasiStaticSolver {
   SolverOptions opt_;
   Vec u_ = nullptr, u_prev_ = nullptr, work_ = nullptr;
   Mat H_ = nullptr;
+  Mat J_ = nullptr;  // shell operator H + low-rank parts (only if a term has them)
+  std::vector<EnergyTerm::LowRank> low_rank_;
+  void clear_low_rank();
   SNES snes_ = nullptr;
   double t_ = 0.0, dt_prev_ = 0.0;
   double fnorm0_ = 0.0, fnorm_scale_ = 0.0;
