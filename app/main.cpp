@@ -30,7 +30,7 @@ const char* kUsage =
     "usage: morphfem <command> [arguments] [PETSc options]\n"
     "commands:\n"
     "  run SCENE.yaml               simulate a scene; results to the scene's output.directory\n"
-    "  verify [--case NAME]... [--quick] [--json] [--out DIR]\n"
+    "  verify [--case NAME]... [--hard] [--quick] [--json] [--out DIR]\n"
     "                               verification cases (patch, mms, cylinder, cantilever) with\n"
     "                               error against the reference beside wall time\n"
     "  fit-materials [--data-dir DIR] [--max-strain S] [--json]\n"
@@ -82,6 +82,7 @@ int cmd_verify(const std::vector<std::string>& args) {
   for (size_t i = 0; i < args.size(); ++i) {
     if (args[i] == "--case" && i + 1 < args.size()) options.cases.push_back(args[++i]);
     else if (args[i] == "--quick") options.quick = true;
+    else if (args[i] == "--hard") options.hard = true;
     else if (args[i] == "--json") json = true;
     else if (args[i] == "--out" && i + 1 < args.size()) out_dir = args[++i];
     else if (args[i].rfind("--", 0) == 0) throw morphfem::InputError("morphfem verify", "unknown option " + args[i]);

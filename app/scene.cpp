@@ -6,6 +6,7 @@
 #include <set>
 
 #include "core/errors.h"
+#include "fem/elastic.h"
 
 namespace morphfem {
 
@@ -123,7 +124,7 @@ Scene read_scene(const std::string& path) {
   // Solver first: load ramps need end_time.
   if (const auto s = root["solver"]) {
     r.allow(s, "solver", {"end_time", "initial_step", "min_step", "max_step", "linear_solver",
-                          "quadrature_degree", "max_newton_its", "rtol"});
+                          "quadrature_degree", "max_newton_its", "rtol", "formulation"});
     auto positive = [&](const char* key, double& out) {
       if (s[key]) {
         out = r.number(s[key], std::string("solver.") + key);
@@ -139,6 +140,14 @@ Scene read_scene(const std::string& path) {
       scene.solver.linear_solver = r.text(s["linear_solver"], "solver.linear_solver");
       if (scene.solver.linear_solver != "mumps" && scene.solver.linear_solver != "gamg")
         r.fail(s["linear_solver"], "solver.linear_solver", "must be 'mumps' or 'gamg'");
+    }
+    if (s["formulation"]) {
+      scene.formulation = r.text(s["formulation"], "solver.formulation");
+      if (!elastic_formulations().count(scene.formulation)) {
+        std::string known;
+        for (const auto& [name, f] : elastic_formulations()) known += (known.empty() ? "" : ", ") + name;
+        r.fail(s["formulation"], "solver.formulation", "unknown formulation '" + scene.formulation + "' (known: " + known + ")");
+      }
     }
     if (s["quadrature_degree"]) {
       double q = r.number(s["quadrature_degree"], "solver.quadrature_degree");

@@ -20,7 +20,8 @@
 //     tractions:
 //       - {surface: tip, traction: [0, 0, -100]}  # dead load [Pa], ramped like pressure
 //   solver: {end_time: 1, initial_step: 0.1, min_step: 1e-6, max_step: 1,
-//            linear_solver: mumps|gamg, quadrature_degree: 0, max_newton_its: 30}
+//            linear_solver: mumps|gamg, quadrature_degree: 0, max_newton_its: 30,
+//            formulation: displacement}
 //   output: {directory: results/demo, every: 1}
 #pragma once
 #include <array>
@@ -66,6 +67,7 @@ struct Scene {
   std::function<Eigen::Vector3d(const Eigen::Vector3d& X, double t)> body_force;
   int body_force_degree = 4;
   SolverOptions solver;
+  std::string formulation = "displacement";  // elastic element formulation (fem/elastic.h)
   int quadrature_degree = 0;
   std::string output_dir;       // empty: no files
   int output_every = 1;

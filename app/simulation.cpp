@@ -136,7 +136,10 @@ SimulationResult run_scene(const Scene& scene, MPI_Comm comm, const RunOptions& 
   Partition partition = partition_mesh(mesh, size);
 
   Assembler assembler(mesh, partition, comm);
-  auto elastic = std::make_shared<ElasticTerm>(mesh, partition, rank, materials, scene.quadrature_degree);
+  const auto formulation = elastic_formulations().find(scene.formulation);
+  if (formulation == elastic_formulations().end())
+    throw InputError(scene_key(scene, "", "solver.formulation"), "unknown formulation '" + scene.formulation + "'");
+  auto elastic = formulation->second(mesh, partition, rank, materials, scene.quadrature_degree);
   assembler.add_term(elastic);
   if (scene.gravity.norm() > 0) {
     // Gravity is a body force rho g [N/m^3]; rho depends on the cell's region, so

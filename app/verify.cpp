@@ -7,6 +7,7 @@
 #include <set>
 
 #include "app/simulation.h"
+#include "app/verify_cases.h"
 #include "core/errors.h"
 #include "core/json.h"
 #include "fem/element.h"
@@ -23,20 +24,24 @@ std::string VerificationRecord::json() const {
   return j.str();
 }
 
-namespace {
-
-constexpr double kPi = 3.14159265358979323846;
-
-ParamSet params(std::initializer_list<std::pair<const char*, double>> numbers, const char* type_key = nullptr,
-                const char* type = nullptr) {
+ParamSet verification_params(std::initializer_list<std::pair<const char*, double>> numbers, const char* text_key,
+                             const char* text) {
   ParamSet p("verification");
   for (const auto& [k, v] : numbers) p.set(k, v);
-  if (type_key) p.set_string(type_key, type);
+  if (text_key) p.set_string(text_key, text);
   return p;
 }
 
-VerificationRecord record_of(const std::string& case_name, const std::string& quantity, int level, int order,
-                             double h, const SimulationResult& r) {
+Scene verification_scene(const std::string& name, ParamSet geometry, ParamSet material) {
+  Scene s;
+  s.name = name;
+  s.geometry = std::move(geometry);
+  s.materials["body"] = std::move(material);
+  return s;
+}
+
+VerificationRecord verification_record(const std::string& case_name, const std::string& quantity, int level,
+                                       int order, double h, const SimulationResult& r) {
   VerificationRecord rec;
   rec.case_name = case_name;
   rec.quantity = quantity;
@@ -51,9 +56,13 @@ VerificationRecord record_of(const std::string& case_name, const std::string& qu
   return rec;
 }
 
-void check_completed(const SimulationResult& r, const std::string& what) {
+void require_completed(const SimulationResult& r, const std::string& what) {
   if (!r.stats.completed) throw SolveError(what + ": " + r.stats.failure);
 }
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
 
 // Deformation gradient of the discrete field at reference point xi of cell c.
 Mat3 cell_F(const Mesh& mesh, const RowMatrixXd& u, int c, const Eigen::Vector3d& xi, Eigen::Matrix3d* grad_u = nullptr,
@@ -77,14 +86,6 @@ Mat3 cell_F(const Mesh& mesh, const RowMatrixXd& u, int c, const Eigen::Vector3d
   return Mat3::Identity() + G;
 }
 
-Scene base_scene(const std::string& name, ParamSet geometry, ParamSet material) {
-  Scene s;
-  s.name = name;
-  s.geometry = std::move(geometry);
-  s.materials["body"] = std::move(material);
-  return s;
-}
-
 // ---------------------------------------------------------------- case 1: patch test
 // Affine u = (F - I) X imposed on the whole boundary of a distorted block: the
 // discrete solution must be exactly affine (nodes and F in every cell).
@@ -96,9 +97,9 @@ void patch_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<Verificatio
   for (int order : {1, 2})
     for (size_t level = 0; level < divisions.size(); ++level) {
       const double h = L / divisions[level];
-      Scene s = base_scene("patch", params({{"lx", L}, {"ly", L}, {"lz", L}, {"mesh_size", h}, {"order", double(order)},
+      Scene s = verification_scene("patch", verification_params({{"lx", L}, {"ly", L}, {"lz", L}, {"mesh_size", h}, {"order", double(order)},
                                             {"distort", 0.25}}, "type", "block"),
-                           params({{"mu", 1e5}, {"kappa", 5e5}}, "model", "neo_hookean"));
+                           verification_params({{"mu", 1e5}, {"kappa", 5e5}}, "model", "neo_hookean"));
       const Mat3 G = F - Mat3::Identity();
       for (const char* face : {"xmin", "xmax", "ymin", "ymax", "zmin", "zmax"}) {
         BoundarySpec b;
@@ -110,7 +111,7 @@ void patch_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<Verificatio
       s.solver.t_end = 1.0;
       s.solver.dt_initial = 0.5;
       auto r = run_scene(s, comm, {false, opt.progress, {}});
-      check_completed(r, "patch test");
+      require_completed(r, "patch test");
       double err_u = 0, scale_u = 0, err_F = 0;
       for (int n = 0; n < r.mesh.n_nodes(); ++n) {
         const Eigen::Vector3d exact = G * r.mesh.X.row(n).transpose();
@@ -119,7 +120,7 @@ void patch_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<Verificatio
       }
       for (int c = 0; c < r.mesh.n_cells(); ++c)
         err_F = std::max(err_F, (cell_F(r.mesh, r.u, c, Eigen::Vector3d(0.25, 0.25, 0.25)) - F).norm() / G.norm());
-      auto rec = record_of("patch", "max_rel_error_u_and_F", int(level), order, h, r);
+      auto rec = verification_record("patch", "max_rel_error_u_and_F", int(level), order, h, r);
       rec.value = std::max(err_u / scale_u, err_F);
       rec.reference = 0.0;
       rec.rel_error = rec.value;
@@ -153,7 +154,7 @@ void mms_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<VerificationR
   m.a = 0.04 / m.c;  // strains of a few percent
   m.w << 1.0, 0.5, 0.3, 0.2, 1.0, 0.7, 0.6, 0.4, 1.0;
   m.phi = Eigen::Vector3d(0.1, 0.7, 1.3);
-  ParamSet material = params({{"mu", 1e5}, {"kappa", 3e5}}, "model", "neo_hookean");
+  ParamSet material = verification_params({{"mu", 1e5}, {"kappa", 3e5}}, "model", "neo_hookean");
   std::shared_ptr<const Material> law = make_material(material);
   auto body_force = [m, law](const Eigen::Vector3d& X, double) {
     Mat3 F = Mat3::Identity() + m.grad(X);
@@ -177,7 +178,7 @@ void mms_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<VerificationR
     double prev_L2 = 0, prev_H1 = 0, prev_h = 0;
     for (size_t level = 0; level < divisions.size(); ++level) {
       const double h = L / divisions[level];
-      Scene s = base_scene("mms", params({{"lx", L}, {"ly", L}, {"lz", L}, {"mesh_size", h}, {"order", double(order)},
+      Scene s = verification_scene("mms", verification_params({{"lx", L}, {"ly", L}, {"lz", L}, {"mesh_size", h}, {"order", double(order)},
                                           {"structured", 1}}, "type", "block"),
                            material);
       for (const char* face : {"xmin", "xmax", "ymin", "ymax", "zmin", "zmax"}) {
@@ -192,7 +193,7 @@ void mms_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<VerificationR
       s.solver.t_end = 1.0;
       s.solver.dt_initial = 0.5;
       auto r = run_scene(s, comm, {false, opt.progress, {}});
-      check_completed(r, "manufactured solution");
+      require_completed(r, "manufactured solution");
       // Errors by degree-6 quadrature: ||u_h - u||_L2 / ||u||_L2, |u_h - u|_H1 / |u|_H1.
       double e_L2 = 0, n_L2 = 0, e_H1 = 0, n_H1 = 0;
       for (int c = 0; c < r.mesh.n_cells(); ++c)
@@ -211,7 +212,7 @@ void mms_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<VerificationR
         }
       const double L2 = std::sqrt(e_L2 / n_L2), H1 = std::sqrt(e_H1 / n_H1);
       for (int which = 0; which < 2; ++which) {
-        auto rec = record_of("mms", which == 0 ? "L2_error" : "H1_error", int(level), order, h, r);
+        auto rec = verification_record("mms", which == 0 ? "L2_error" : "H1_error", int(level), order, h, r);
         rec.value = which == 0 ? L2 : H1;
         rec.reference = 0;
         rec.rel_error = rec.value;
@@ -242,9 +243,9 @@ void cylinder_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<Verifica
   for (int order : orders)
     for (size_t level = 0; level < sizes.size(); ++level) {
       const double h = sizes[level];
-      Scene s = base_scene("cylinder", params({{"inner_radius", A}, {"outer_radius", B}, {"mesh_size", h},
+      Scene s = verification_scene("cylinder", verification_params({{"inner_radius", A}, {"outer_radius", B}, {"mesh_size", h},
                                                {"order", double(order)}}, "type", "thick_cylinder"),
-                           params({{"mu", mu}, {"kappa", kappa}}, "model", "neo_hookean"));
+                           verification_params({{"mu", mu}, {"kappa", kappa}}, "model", "neo_hookean"));
       for (auto [face, axis] : std::vector<std::pair<const char*, int>>{{"sym_x", 0}, {"sym_y", 1}, {"zmin", 2}, {"zmax", 2}}) {
         BoundarySpec b;
         b.surface = face;
@@ -261,7 +262,7 @@ void cylinder_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<Verifica
       s.solver.dt_initial = 0.1;
       s.solver.dt_max = 0.25;
       auto r = run_scene(s, comm, {false, opt.progress, {}});
-      check_completed(r, "thick cylinder");
+      require_completed(r, "thick cylinder");
       // Inner stretch from the inner wall's vertices: la = mean |x_xy| / A.
       std::set<int> vertices;
       for (int f : r.mesh.faces_of("inner"))
@@ -272,12 +273,12 @@ void cylinder_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<Verifica
         sum += std::hypot(x[0], x[1]);
       }
       const double la = sum / vertices.size() / A;
-      auto rec = record_of("cylinder", "P/mu at computed inner stretch", int(level), order, h, r);
+      auto rec = verification_record("cylinder", "P/mu at computed inner stretch", int(level), order, h, r);
       rec.value = p_over_mu;
       rec.reference = cylinder_pressure(la, A / B);
       rec.rel_error = std::abs(rec.value - rec.reference) / rec.reference;
       out.push_back(rec);
-      auto srec = record_of("cylinder", "inner stretch (reference 2.0)", int(level), order, h, r);
+      auto srec = verification_record("cylinder", "inner stretch (reference 2.0)", int(level), order, h, r);
       srec.value = la;
       srec.reference = 2.0;
       srec.rel_error = std::abs(la - 2.0) / 2.0;
@@ -296,9 +297,9 @@ void cantilever_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<Verifi
     if (opt.quick && order == 1) continue;
     for (size_t level = 0; level < sizes.size(); ++level) {
       const double size = sizes[level];
-      Scene s = base_scene("cantilever", params({{"L", L}, {"b", b}, {"h", h}, {"mesh_size", size},
+      Scene s = verification_scene("cantilever", verification_params({{"L", L}, {"b", b}, {"h", h}, {"mesh_size", size},
                                                  {"order", double(order)}, {"structured", 1}}, "type", "cantilever"),
-                           params({{"mu", mu}, {"kappa", 2 * mu / 3}}, "model", "neo_hookean"));
+                           verification_params({{"mu", mu}, {"kappa", 2 * mu / 3}}, "model", "neo_hookean"));
       BoundarySpec clamp;
       clamp.surface = "root";
       clamp.components = {true, true, true};
@@ -326,9 +327,9 @@ void cantilever_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<Verifi
           }
       };
       auto r = run_scene(s, comm, run);
-      check_completed(r, "cantilever");
+      require_completed(r, "cantilever");
       for (const auto& [k, v] : deflection) {
-        auto rec = record_of("cantilever", "tip deflection v/L, k=" + std::to_string(k), int(level), order, size, r);
+        auto rec = verification_record("cantilever", "tip deflection v/L, k=" + std::to_string(k), int(level), order, size, r);
         rec.value = v;
         rec.reference = reference.at(k);
         rec.rel_error = std::abs(v - rec.reference) / rec.reference;
@@ -338,27 +339,41 @@ void cantilever_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<Verifi
   }
 }
 
-const std::map<std::string, std::function<void(const VerifyOptions&, MPI_Comm, std::vector<VerificationRecord>&)>>&
-cases() {
-  static const std::map<std::string, std::function<void(const VerifyOptions&, MPI_Comm, std::vector<VerificationRecord>&)>>
-      registry{{"patch", patch_case}, {"mms", mms_case}, {"cylinder", cylinder_case}, {"cantilever", cantilever_case}};
+struct CaseEntry {
+  VerificationCase run;
+  bool hard;
+};
+
+// The one table of verification cases.
+const std::map<std::string, CaseEntry>& cases() {
+  static const std::map<std::string, CaseEntry> registry{
+      {"patch", {patch_case, false}},
+      {"mms", {mms_case, false}},
+      {"cylinder", {cylinder_case, false}},
+      {"cantilever", {cantilever_case, false}},
+  };
   return registry;
 }
 
 }  // namespace
 
-std::vector<std::string> verification_case_names() { return {"patch", "mms", "cylinder", "cantilever"}; }
+std::vector<std::string> verification_case_names(bool hard) {
+  std::vector<std::string> names;
+  for (const auto& [name, entry] : cases())
+    if (entry.hard == hard) names.push_back(name);
+  return names;
+}
 
 std::vector<VerificationRecord> run_verification(const VerifyOptions& options, MPI_Comm comm) {
-  std::vector<std::string> names = options.cases.empty() ? verification_case_names() : options.cases;
+  std::vector<std::string> names = options.cases.empty() ? verification_case_names(options.hard) : options.cases;
   for (const auto& n : names)
     if (!cases().count(n)) {
       std::string known;
-      for (const auto& k : verification_case_names()) known += (known.empty() ? "" : ", ") + k;
+      for (const auto& [k, entry] : cases()) known += (known.empty() ? "" : ", ") + k;
       throw InputError("--case", "unknown verification case '" + n + "' (known: " + known + ")");
     }
   std::vector<VerificationRecord> out;
-  for (const auto& n : names) cases().at(n)(options, comm, out);
+  for (const auto& n : names) cases().at(n).run(options, comm, out);
   return out;
 }
 

@@ -22,12 +22,14 @@ struct VerificationRecord {
 };
 
 struct VerifyOptions {
-  std::vector<std::string> cases;  // empty: all (patch, mms, cylinder, cantilever)
+  std::vector<std::string> cases;  // empty: every core case (or every hard case with `hard`)
+  bool hard = false;               // the hard-case suite instead of the core cases
   bool quick = false;              // coarse levels only (the ctest subset)
   bool progress = true;
 };
 
-std::vector<std::string> verification_case_names();
+// Registered case names: the core suite, or the hard-case suite.
+std::vector<std::string> verification_case_names(bool hard = false);
 // Runs the cases; throws InputError for an unknown case name.
 std::vector<VerificationRecord> run_verification(const VerifyOptions& options, MPI_Comm comm);
 

@@ -96,4 +96,13 @@ ElasticTerm::CellMeasures ElasticTerm::measures(int k, const PieceState& s) cons
   return {J_sum / volume, J_min, vm_sum / volume};
 }
 
+const std::map<std::string, ElasticTermFactory>& elastic_formulations() {
+  static const std::map<std::string, ElasticTermFactory> registry{
+      {"displacement",
+       [](const Mesh& mesh, const Partition& partition, int rank, std::vector<std::shared_ptr<const Material>> materials,
+          int degree) { return std::make_shared<ElasticTerm>(mesh, partition, rank, std::move(materials), degree); }},
+  };
+  return registry;
+}
+
 }  // namespace morphfem

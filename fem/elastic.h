@@ -2,7 +2,10 @@
 // F = I + grad_X u. One piece per cell owned by this rank; the material is chosen
 // by the cell's volume region.
 #pragma once
+#include <functional>
+#include <map>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "fem/element.h"
@@ -33,11 +36,18 @@ class ElasticTerm : public EnergyTerm {
   CellMeasures measures(int k, const PieceState& s) const;
   int cell_of_piece(int k) const { return cells_[k]; }
 
- private:
+ protected:
   const Mesh& mesh_;
   std::vector<int> cells_;
   std::vector<std::shared_ptr<const Material>> materials_;
   ShapeTable table_;
 };
+
+// Element formulations of the elastic energy, registered by name in one table
+// (elastic.cpp): "displacement" (pure displacement, this file). Scenes choose one
+// with `solver: {formulation: NAME}`.
+using ElasticTermFactory = std::function<std::shared_ptr<ElasticTerm>(
+    const Mesh&, const Partition&, int rank, std::vector<std::shared_ptr<const Material>>, int quadrature_degree)>;
+const std::map<std::string, ElasticTermFactory>& elastic_formulations();
 
 }  // namespace morphfem

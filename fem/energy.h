@@ -48,6 +48,11 @@ class EnergyTerm {
   // keep history (velocities, lagged normal forces, gas amounts) here.
   virtual void begin_step(class Assembler& /*assembler*/, Vec /*u0*/, double /*t0*/, double /*t1*/) {}
   virtual void end_step(class Assembler& /*assembler*/, Vec /*u1*/, double /*t1*/) {}
+  // After Newton converged at t1 and before end_step: a term may update its own
+  // parameters (e.g. an augmented-Lagrangian multiplier of a volume constraint)
+  // and return true to ask for another solve of the same step (at most
+  // SolverOptions::max_outer_updates times). Collective. Default: false.
+  virtual bool update_after_solve(class Assembler& /*assembler*/, Vec /*u1*/) { return false; }
 
   // Largest fraction alpha in (0, 1] such that u + alpha du stays admissible for
   // this term (e.g. no node crosses a contact barrier). Collective. Default 1.

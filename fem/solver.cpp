@@ -284,15 +284,23 @@ bool QuasiStaticSolver::solve_step(double t_new, int& newton_its, int& linear_it
   Vec x;
   PETSC_CHECK(VecDuplicate(u_, &x));
   PETSC_CHECK(VecCopy(work_, x));
-  PetscErrorCode ierr = SNESSolve(snes_, nullptr, x);
+  PetscErrorCode ierr = 0;
   SNESConvergedReason reason = SNES_DIVERGED_FUNCTION_DOMAIN;
-  if (!ierr) {
+  newton_its = linear_its = 0;
+  for (int outer = 0; outer <= opt_.max_outer_updates; ++outer) {
+    ierr = SNESSolve(snes_, nullptr, x);
+    if (ierr) break;
     SNESGetConvergedReason(snes_, &reason);
     PetscInt its = 0, lits = 0;
     SNESGetIterationNumber(snes_, &its);
     SNESGetLinearSolveIterations(snes_, &lits);
-    newton_its = static_cast<int>(its);
-    linear_its = static_cast<int>(lits);
+    newton_its += static_cast<int>(its);
+    linear_its += static_cast<int>(lits);
+    if (reason <= 0) break;
+    bool again = false;
+    for (const auto& term : assembler_.terms()) again = term->update_after_solve(assembler_, x) || again;
+    if (!again) break;
+    if (outer == opt_.max_outer_updates) reason = SNES_DIVERGED_MAX_IT;
   }
   const bool ok = !ierr && reason > 0 && std::isfinite(assembler_.energy(x));
   if (ok) {

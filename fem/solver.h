@@ -36,6 +36,7 @@ struct SolverOptions {
   double grow = 1.5;          // step growth after an easy solve
   int easy_newton_its = 6;    // "easy": converged in at most this many iterations
   int max_newton_its = 30;
+  int max_outer_updates = 20; // re-solves a step while a term's update_after_solve asks
   double rtol = 1e-9;         // ||r|| <= rtol ||r_0|| ...
   double atol_factor = 1e-11; // ... or ||r|| <= atol_factor * (largest ||r_0|| seen)
   std::string linear_solver = "mumps";  // "mumps" | "gamg"
