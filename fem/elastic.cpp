@@ -1,4 +1,5 @@
 #include "fem/elastic.h"
+#include "fem/mean_dilatation.h"
 
 #include <cmath>
 #include <limits>
@@ -101,6 +102,11 @@ const std::map<std::string, ElasticTermFactory>& elastic_formulations() {
       {"displacement",
        [](const Mesh& mesh, const Partition& partition, int rank, std::vector<std::shared_ptr<const Material>> materials,
           int degree) { return std::make_shared<ElasticTerm>(mesh, partition, rank, std::move(materials), degree); }},
+      {"mean_dilatation",
+       [](const Mesh& mesh, const Partition& partition, int rank, std::vector<std::shared_ptr<const Material>> materials,
+          int degree) -> std::shared_ptr<ElasticTerm> {
+         return std::make_shared<MeanDilatationTerm>(mesh, partition, rank, std::move(materials), degree);
+       }},
   };
   return registry;
 }

@@ -118,4 +118,19 @@ void InvariantMaterial::evaluate(const Mat3& F, double& W, Mat3& P, Tangent* A) 
   invariant_stress_tangent(F, inv, iso, vol, uses_I2_, P, A);
 }
 
+// Isochoric part: the same chain rule with U = U' = U'' = 0.
+void InvariantMaterial::evaluate_isochoric(const Mat3& F, double& W, Mat3& P, Tangent* A) const {
+  const Invariants inv = invariants(F);
+  const IsochoricDerivatives iso = isochoric(inv.Ibar1, inv.Ibar2, A != nullptr);
+  W = iso.W;
+  invariant_stress_tangent(F, inv, iso, Volumetric{0.0, 0.0, 0.0}, uses_I2_, P, A);
+}
+
+void InvariantMaterial::volumetric_energy(double J, double& U, double& dU, double& d2U) const {
+  const Volumetric vol = volumetric(kappa_, J);
+  U = vol.U;
+  dU = vol.dU;
+  d2U = vol.ddU;
+}
+
 }  // namespace morphfem

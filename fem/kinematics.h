@@ -76,6 +76,8 @@ class InvariantMaterial : public Material {
  public:
   double energy(const Mat3& F) const override;
   void evaluate(const Mat3& F, double& W, Mat3& P, Tangent* A) const override;
+  void evaluate_isochoric(const Mat3& F, double& W, Mat3& P, Tangent* A) const override;
+  void volumetric_energy(double J, double& U, double& dU, double& d2U) const override;
   double bulk_modulus() const override { return kappa_; }
 
  protected:

@@ -2,6 +2,8 @@
 //   body force     E = - int_V  b(X, t) . u dV      b [N/m^3] (gravity: rho g)
 //   surface load   E = - int_S  t(X, t) . u dA      t [Pa]    (reference area)
 // Their gradients are the (negated) consistent nodal forces; Hessians are zero.
+// The nodal forces of every piece are computed once per time (set_time) and
+// reused by every sweep: the energy is then -f_e . u_e.
 #pragma once
 #include <functional>
 
@@ -23,14 +25,15 @@ class BodyForceTerm : public EnergyTerm {
   int n_pieces() const override { return static_cast<int>(cells_.size()); }
   void piece_nodes(int k, std::vector<int>& nodes) const override;
   double piece(int k, const PieceState& s, Eigen::VectorXd* g, Eigen::MatrixXd* H) const override;
-  void set_time(double t) override { time_ = t; }
+  void set_time(double t) override;
 
  private:
   const Mesh& mesh_;
   std::vector<int> cells_;
   VectorField force_;
   ShapeTable table_;
-  double time_ = 0.0;
+  double time_ = -1.0;
+  std::vector<Eigen::VectorXd> nodal_force_;  // per piece, 3n [N]
 };
 
 // Pieces: the given boundary faces whose first node this rank owns.
@@ -42,14 +45,15 @@ class SurfaceLoadTerm : public EnergyTerm {
   int n_pieces() const override { return static_cast<int>(faces_.size()); }
   void piece_nodes(int k, std::vector<int>& nodes) const override;
   double piece(int k, const PieceState& s, Eigen::VectorXd* g, Eigen::MatrixXd* H) const override;
-  void set_time(double t) override { time_ = t; }
+  void set_time(double t) override;
 
  private:
   const Mesh& mesh_;
   std::vector<int> faces_;
   VectorField traction_;
   ShapeTable table_;
-  double time_ = 0.0;
+  double time_ = -1.0;
+  std::vector<Eigen::VectorXd> nodal_force_;  // per piece, 3n [N]
 };
 
 // The faces among `faces` that rank `rank` assembles (owner of the face's first node).

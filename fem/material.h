@@ -31,6 +31,16 @@ class Material {
   virtual double energy(const Mat3& F) const = 0;
   // W, P and (if A != nullptr) A at F. Requires det F > 0.
   virtual void evaluate(const Mat3& F, double& W, Mat3& P, Tangent* A) const = 0;
+  // The isochoric part alone, W_iso(F) = W(F) - U(J) [Pa] (a function of
+  // Fbar = J^(-1/3) F), P_iso = dW_iso/dF [Pa] and (if A != nullptr)
+  // A_iso = dP_iso/dF [Pa]. Requires det F > 0. Element formulations that
+  // discretise the volume change separately (mean dilatation) combine it with
+  // volumetric_energy() evaluated at their own dilatation.
+  virtual void evaluate_isochoric(const Mat3& F, double& W, Mat3& P, Tangent* A) const = 0;
+  // The volumetric part U(J) = kappa/4 (J^2 - 1 - 2 ln J) [Pa] and its derivatives
+  // dU = U'(J) = kappa/2 (J - 1/J), d2U = U''(J) = kappa/2 (1 + 1/J^2) [Pa].
+  // Requires J > 0. W(F) = W_iso(F) + U(det F) for every law.
+  virtual void volumetric_energy(double J, double& U, double& dU, double& d2U) const = 0;
   // Small-strain shear and bulk moduli [Pa] (for reporting, time steps, penalties).
   virtual double shear_modulus() const = 0;
   virtual double bulk_modulus() const = 0;

@@ -73,12 +73,25 @@ class Ogden final : public Material {
     return W;
   }
 
-  void evaluate(const Mat3& F, double& W, Mat3& P, Tangent* A) const override {
+  void evaluate(const Mat3& F, double& W, Mat3& P, Tangent* A) const override { evaluate_split(F, W, P, A, true); }
+  void evaluate_isochoric(const Mat3& F, double& W, Mat3& P, Tangent* A) const override {
+    evaluate_split(F, W, P, A, false);
+  }
+  void volumetric_energy(double J, double& U, double& dU, double& d2U) const override {
+    const Volumetric vol = volumetric(kappa_, J);
+    U = vol.U;
+    dU = vol.dU;
+    d2U = vol.ddU;
+  }
+
+ private:
+  // W, P, A of the whole law (with_volumetric) or of its isochoric part alone.
+  void evaluate_split(const Mat3& F, double& W, Mat3& P, Tangent* A, bool with_volumetric) const {
     const double J = F.determinant();
     const Eigen::SelfAdjointEigenSolver<Mat3> eig(F.transpose() * F);
     const Eigen::Vector3d c = eig.eigenvalues();
     const Mat3& N = eig.eigenvectors();  // columns n_a
-    const Volumetric vol = volumetric(kappa_, J);
+    const Volumetric vol = with_volumetric ? volumetric(kappa_, J) : Volumetric{0.0, 0.0, 0.0};
     Vec9 gJ;
     Tangent HJ;
     det_derivatives(F, J, gJ, A ? &HJ : nullptr);
@@ -143,7 +156,6 @@ class Ogden final : public Material {
       }
   }
 
- private:
   int n_;
   double mu_[kMaxTerms] = {}, alpha_[kMaxTerms] = {};
   double kappa_;

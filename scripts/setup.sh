@@ -14,7 +14,7 @@ cd "$(dirname "$0")/.."
 packages=(build-essential cmake pkg-config git
           petsc-dev libmumps-dev libmetis-dev libgmsh-dev libeigen3-dev
           libhdf5-openmpi-dev libyaml-cpp-dev libgtest-dev openmpi-bin
-          python3 python3-matplotlib python3-numpy python3-h5py)
+          libopenblas0-pthread python3 python3-matplotlib python3-numpy python3-h5py)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
