@@ -116,7 +116,8 @@ Scene read_scene(const std::string& path) {
                      "YAML syntax error: " + e.msg);
   }
   if (!root.IsMap()) throw InputError(path, "a scene must be a mapping with keys geometry/mesh, materials, ...");
-  r.allow(root, "", {"name", "geometry", "mesh", "materials", "boundary", "loads", "solver", "output"});
+  r.allow(root, "", {"name", "geometry", "mesh", "materials", "boundary", "loads", "solver", "output", "dynamics",
+                     "contact"});
   Scene scene;
   scene.source = path;
   if (root["name"]) scene.name = r.text(root["name"], "name");
@@ -242,6 +243,88 @@ Scene read_scene(const std::string& path) {
       }
     }
   }
+
+  if (const auto d = root["dynamics"]) {
+    r.allow(d, "dynamics", {"scheme", "lumped", "adaptive", "error_tolerance", "shear_viscosity", "bulk_viscosity",
+                            "initial_velocity"});
+    scene.dynamic = true;
+    if (d["scheme"]) {
+      const std::string name = r.text(d["scheme"], "dynamics.scheme");
+      const auto it = time_schemes().find(name);
+      if (it == time_schemes().end()) {
+        std::string known;
+        for (const auto& [k, v] : time_schemes()) known += (known.empty() ? "" : ", ") + k;
+        r.fail(d["scheme"], "dynamics.scheme", "unknown scheme '" + name + "' (known: " + known + ")");
+      }
+      scene.inertia.scheme = it->second;
+    }
+    auto flag = [&](const char* key, bool& out) {
+      if (d[key]) out = r.number(d[key], std::string("dynamics.") + key) != 0;
+    };
+    flag("lumped", scene.inertia.lumped);
+    flag("adaptive", scene.inertia.adaptive);
+    auto nonnegative = [&](const char* key, double& out) {
+      if (!d[key]) return;
+      out = r.number(d[key], std::string("dynamics.") + key);
+      if (out < 0) r.fail(d[key], std::string("dynamics.") + key, "must not be negative");
+    };
+    nonnegative("error_tolerance", scene.inertia.error_tolerance);
+    nonnegative("shear_viscosity", scene.shear_viscosity);
+    nonnegative("bulk_viscosity", scene.bulk_viscosity);
+    if (d["initial_velocity"]) scene.initial_velocity = r.vector3(d["initial_velocity"], "dynamics.initial_velocity");
+  }
+
+  if (const auto c = root["contact"]) {
+    r.allow(c, "contact", {"ground", "friction"});
+    if (const auto g = c["ground"]) {
+      r.allow(g, "contact.ground", {"point", "normal", "surfaces", "dhat", "kappa"});
+      scene.ground_contact = true;
+      if (!g["surfaces"]) r.fail(g, "contact.ground", "missing key 'surfaces'");
+      scene.ground.surfaces = r.texts(g["surfaces"], "contact.ground.surfaces");
+      if (g["point"]) scene.ground.point = r.vector3(g["point"], "contact.ground.point");
+      if (g["normal"]) {
+        scene.ground.normal = r.vector3(g["normal"], "contact.ground.normal");
+        if (scene.ground.normal.norm() == 0) r.fail(g["normal"], "contact.ground.normal", "must not be zero");
+      }
+      if (g["dhat"]) scene.ground.dhat = r.number(g["dhat"], "contact.ground.dhat");
+      if (g["kappa"]) scene.ground.kappa = r.number(g["kappa"], "contact.ground.kappa");
+    }
+    if (const auto f = c["friction"]) {
+      r.allow(f, "contact.friction", {"eps_v", "lag_updates", "regions"});
+      if (!scene.ground_contact) r.fail(f, "contact.friction", "friction needs contact.ground");
+      scene.friction = true;
+      if (f["eps_v"]) {
+        scene.friction_spec.eps_v = r.number(f["eps_v"], "contact.friction.eps_v");
+        if (!(scene.friction_spec.eps_v > 0)) r.fail(f["eps_v"], "contact.friction.eps_v", "must be positive");
+      }
+      if (f["lag_updates"]) scene.friction_spec.lag_updates = int(r.number(f["lag_updates"], "contact.friction.lag_updates"));
+      if (!f["regions"] || !f["regions"].IsSequence())
+        r.fail(f, "contact.friction", "missing 'regions: [{surface, mu_static, mu_kinetic}, ...]'");
+      for (const auto& reg : f["regions"]) {
+        r.allow(reg, "contact.friction.regions", {"surface", "mu_static", "mu_kinetic", "mu"});
+        FrictionRegion region;
+        if (!reg["surface"]) r.fail(reg, "contact.friction.regions", "missing key 'surface'");
+        region.surface = r.text(reg["surface"], "contact.friction.regions.surface");
+        // mu: a constant or a table of (time, mu); mu sets both coefficients.
+        auto coefficient = [&](const YAML::Node& node, const std::string& key) {
+          if (node.IsScalar()) return TimeFunction::constant(r.number(node, key));
+          return r.ramp_or_table(node, key, end);
+        };
+        const YAML::Node both = reg["mu"];
+        const YAML::Node ms = reg["mu_static"] ? reg["mu_static"] : both;
+        const YAML::Node mk = reg["mu_kinetic"] ? reg["mu_kinetic"] : both;
+        if (!ms || !mk) r.fail(reg, "contact.friction.regions", "give 'mu' or both 'mu_static' and 'mu_kinetic'");
+        region.mu_static = coefficient(ms, "contact.friction.regions.mu_static");
+        region.mu_kinetic = coefficient(mk, "contact.friction.regions.mu_kinetic");
+        scene.friction_spec.regions.push_back(region);
+      }
+    }
+  }
+
+  if (scene.friction && scene.dynamic && scene.inertia.scheme != TimeScheme::implicit_euler)
+    throw InputError(r.at(root["dynamics"]),
+                     "'dynamics.scheme': friction needs implicit_euler (the friction potential is written with the "
+                     "implicit-Euler slip u - u_n; with bdf2/newmark it would be inconsistent)");
 
   if (const auto o = root["output"]) {
     r.allow(o, "output", {"directory", "every"});

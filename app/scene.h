@@ -22,6 +22,15 @@
 //   solver: {end_time: 1, initial_step: 0.1, min_step: 1e-6, max_step: 1,
 //            linear_solver: mumps|gamg, quadrature_degree: 0, max_newton_its: 30,
 //            formulation: displacement}
+//   dynamics:                                   # absent: quasi-static (no inertia)
+//     {scheme: newmark|bdf2|implicit_euler, lumped: false, adaptive: false,
+//      error_tolerance: 1e-4, shear_viscosity: 0, bulk_viscosity: 0,   # Pa s (Kelvin-Voigt)
+//      initial_velocity: [0, 0, 0]}                                     # m/s
+//   contact:
+//     ground: {point: [0, 0, 0], normal: [0, 0, 1], surfaces: [zmin], dhat: 0, kappa: 0}
+//     friction: {eps_v: 1e-4, lag_updates: 0,
+//                regions: [{surface: zmin, mu_static: 0.5, mu_kinetic: 0.4}]}
+//                # mu: a number or a table [[t, mu], ...] (coefficients that change over time)
 //   output: {directory: results/demo, every: 1}
 #pragma once
 #include <array>
@@ -31,6 +40,9 @@
 #include <vector>
 
 #include "actuation/cavity.h"
+#include "contact/friction.h"
+#include "contact/ground.h"
+#include "fem/inertia.h"
 #include "core/params.h"
 #include "fem/solver.h"
 
@@ -66,6 +78,16 @@ struct Scene {
   // manufactured solution's load), integrated with `body_force_degree`.
   std::function<Eigen::Vector3d(const Eigen::Vector3d& X, double t)> body_force;
   int body_force_degree = 4;
+  // Dynamics (inertia, viscous damping) — only if the scene asks for it.
+  bool dynamic = false;
+  InertiaOptions inertia;
+  double shear_viscosity = 0.0, bulk_viscosity = 0.0;  // [Pa s]
+  Eigen::Vector3d initial_velocity = Eigen::Vector3d::Zero();  // [m/s]
+  // Ground contact and friction — only if declared.
+  bool ground_contact = false;
+  GroundContactSpec ground;
+  bool friction = false;
+  FrictionSpec friction_spec;
   SolverOptions solver;
   std::string formulation = "displacement";  // elastic element formulation (fem/elastic.h)
   int quadrature_degree = 0;

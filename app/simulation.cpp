@@ -3,6 +3,7 @@
 #include <mpi.h>
 
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <limits>
 
@@ -10,7 +11,11 @@
 #include "core/errors.h"
 #include "core/json.h"
 #include "core/progress.h"
+#include "contact/friction.h"
+#include "contact/ground.h"
+#include "fem/damping.h"
 #include "fem/elastic.h"
+#include "fem/inertia.h"
 #include "fem/loads.h"
 #include "fem/material.h"
 #include "fem/output.h"
@@ -111,6 +116,11 @@ Mesh build_scene_mesh(const Scene& scene, MPI_Comm comm) {
   for (const auto& c : scene.cavities)
     for (const auto& s : c.surfaces) require_surface(scene, mesh, s, "", "loads.cavities." + c.name);
   for (const auto& t : scene.tractions) require_surface(scene, mesh, t.surface, t.where, "loads.tractions");
+  if (scene.ground_contact)
+    for (const auto& surface : scene.ground.surfaces) require_surface(scene, mesh, surface, "", "contact.ground.surfaces");
+  if (scene.friction)
+    for (const auto& region : scene.friction_spec.regions)
+      require_surface(scene, mesh, region.surface, "", "contact.friction.regions");
   return mesh;
 }
 
@@ -170,6 +180,37 @@ SimulationResult run_scene(const Scene& scene, MPI_Comm comm, const RunOptions& 
         mesh, partition, rank, mesh.faces_of(t.surface),
         [traction, scale](const Eigen::Vector3d&, double time) { return Eigen::Vector3d(scale(time) * traction); }));
   }
+  // Dynamics: inertia (and viscous damping) only when the scene asks for them.
+  std::shared_ptr<InertiaTerm> inertia;
+  std::shared_ptr<DampingTerm> damping;
+  if (scene.dynamic) {
+    for (const auto& [region, params] : scene.materials)
+      if (density[mesh.region(region, 3).id] <= 0)
+        throw InputError(params.where("model"), "dynamics needs 'density' [kg/m^3] for material '" + region + "'");
+    inertia = std::make_shared<InertiaTerm>(mesh, partition, rank, density, scene.inertia);
+    assembler.add_term(inertia);
+    if (scene.shear_viscosity > 0 || scene.bulk_viscosity > 0) {
+      std::vector<double> eta(mesh.regions.size(), scene.shear_viscosity), zeta(mesh.regions.size(), scene.bulk_viscosity);
+      damping = std::make_shared<DampingTerm>(mesh, partition, rank, eta, zeta, scene.inertia.scheme);
+      assembler.add_term(damping);
+    }
+  }
+  // Ground contact and friction only on the declared surfaces.
+  std::shared_ptr<GroundContactTerm> ground;
+  std::shared_ptr<FrictionTerm> friction;
+  if (scene.ground_contact) {
+    GroundContactSpec spec = scene.ground;
+    double mu_max = 0;
+    for (const auto& m : materials)
+      if (m) mu_max = std::max(mu_max, m->shear_modulus());
+    spec.young_modulus = 3.0 * mu_max;  // nearly incompressible: E = 2 mu (1 + nu) ~ 3 mu
+    ground = std::make_shared<GroundContactTerm>(mesh, partition, rank, spec);
+    assembler.add_term(ground);
+    if (scene.friction) {
+      friction = std::make_shared<FrictionTerm>(mesh, partition, rank, ground, scene.friction_spec);
+      assembler.add_term(friction);
+    }
+  }
   std::vector<DirichletCondition> bcs;
   const double t_end = scene.solver.t_end;
   for (const auto& b : scene.boundary) {
@@ -184,6 +225,11 @@ SimulationResult run_scene(const Scene& scene, MPI_Comm comm, const RunOptions& 
   }
   SolverOptions solver_options = scene.solver;
   QuasiStaticSolver solver(assembler, bcs, solver_options);
+  if (inertia) {
+    const Eigen::Vector3d v0 = scene.initial_velocity;
+    inertia->set_initial_velocity([v0](const Eigen::Vector3d&) { return v0; });
+    inertia->initialize(assembler, solver.solution(), 0.0);
+  }
   result.dofs = assembler.n_dofs();
   for (const auto& c : cavities) result.cavity_names.push_back(c->spec().name);
 
@@ -202,6 +248,10 @@ SimulationResult run_scene(const Scene& scene, MPI_Comm comm, const RunOptions& 
   }
   std::vector<std::string> energy_columns{"time"};
   for (const auto& term : assembler.terms()) energy_columns.push_back(term->name() + "_J");
+  if (inertia) energy_columns.push_back("kinetic_J");
+  if (friction) energy_columns.push_back("friction_dissipated_J");
+  if (damping) energy_columns.push_back("damping_dissipated_J");
+  double friction_dissipated = 0.0;
 
   auto record = [&](double t, bool force_write, int step) {
     result.u = assembler.gather_all(solver.solution());
@@ -236,9 +286,31 @@ SimulationResult run_scene(const Scene& scene, MPI_Comm comm, const RunOptions& 
       MPI_Reduce(vm.data(), vmg.data(), mesh.n_cells(), MPI_DOUBLE, MPI_SUM, 0, comm);
     }
     std::vector<double> energies = assembler.term_energies(solver.solution());
+    if (inertia) energies.push_back(inertia->kinetic_energy(assembler));
+    if (friction) {
+      if (step > 0) friction_dissipated += friction->dissipated(assembler, solver.solution());
+      energies.push_back(friction_dissipated);
+    }
+    if (damping) energies.push_back(damping->total_dissipated());
+    std::vector<Field> contact_fields;
+    if (ground && write && output_now) {
+      auto c = ground->nodal_contact(assembler, solver.solution());
+      contact_fields.push_back(Field{"contact_force_N", 3, std::vector<double>(c.force.data(), c.force.data() + c.force.size())});
+      for (double& g : c.gap)
+        if (!std::isfinite(g)) g = -1.0;  // -1: node not on a contact surface (gaps are always > 0)
+      contact_fields.push_back(Field{"contact_gap_m", 1, c.gap});
+      contact_fields.push_back(Field{"contact_status", 1, std::vector<double>(c.status.begin(), c.status.end())});
+      if (friction) {
+        auto f = friction->nodal_friction(assembler, solver.solution());
+        contact_fields.push_back(Field{"friction_force_N", 3, std::vector<double>(f.force.data(), f.force.data() + f.force.size())});
+        contact_fields.push_back(Field{"friction_status", 1, std::vector<double>(f.status.begin(), f.status.end())});
+      }
+    }
     if (writer && output_now) {
       Field disp{"displacement", 3, std::vector<double>(result.u.data(), result.u.data() + result.u.size())};
-      writer->write_step(t, {disp}, {Field{"J", 1, Jg}, Field{"von_mises_Pa", 1, vmg}});
+      std::vector<Field> nodal{disp};
+      nodal.insert(nodal.end(), contact_fields.begin(), contact_fields.end());
+      writer->write_step(t, nodal, {Field{"J", 1, Jg}, Field{"von_mises_Pa", 1, vmg}});
       std::vector<double> row{t};
       for (size_t i = 0; i < cavities.size(); ++i) {
         row.push_back(result.cavity_pressure[i]);

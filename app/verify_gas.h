@@ -40,6 +40,7 @@ struct PressureControlFailure {
   double last_time = 0;          // time of the last converged state [s]
   bool state_finite = false;     // the kept solution has only finite entries
   double last_volume_ratio = 0;  // V/V_ref of the kept state (from the solution vector)
+  long dofs = 0;
 };
 PressureControlFailure run_pressure_controlled_balloon(bool quick, MPI_Comm comm);
 

@@ -139,13 +139,14 @@ void DampingTerm::begin_step(Assembler& assembler, Vec u0, double t0, double t1)
   std::vector<int> nodes;
   Eigen::MatrixXd X, u;
   const bool first = steps_done_ == 0 || scheme_ == TimeScheme::implicit_euler;
-  double w = 1.0, alpha0 = 1.0, alpha1 = -1.0, alpha2 = 0.0;
+  trapezoidal_ = !first && (scheme_ == TimeScheme::newmark || h_ > kBdf2MaxStepRatio * h_prev_);
+  double alpha0 = 1.0, alpha1 = -1.0, alpha2 = 0.0;
   if (first) {
     kappa_ = 1.0;
-  } else if (scheme_ == TimeScheme::newmark) {
+  } else if (trapezoidal_) {  // newmark, or a bdf2 step that grows too much (as in InertiaTerm)
     kappa_ = 2.0;
   } else {
-    w = h_ / h_prev_;
+    const double w = h_ / h_prev_;
     alpha0 = (1 + 2 * w) / (1 + w), alpha1 = -(1 + w), alpha2 = w * w / (1 + w);
     kappa_ = alpha0;
   }
@@ -156,8 +157,8 @@ void DampingTerm::begin_step(Assembler& assembler, Vec u0, double t0, double t1)
     E_star_[k] = E_n_[k];
     if (first) continue;
     for (size_t q = 0; q < E_n_[k].size(); ++q)
-      E_star_[k][q] = scheme_ == TimeScheme::newmark ? Mat3(E_n_[k][q] + 0.5 * h_ * Edot_n_[k][q])
-                                                     : Mat3(-(alpha1 * E_n_[k][q] + alpha2 * E_nm1_[k][q]) / alpha0);
+      E_star_[k][q] = trapezoidal_ ? Mat3(E_n_[k][q] + 0.5 * h_ * Edot_n_[k][q])
+                                   : Mat3(-(alpha1 * E_n_[k][q] + alpha2 * E_nm1_[k][q]) / alpha0);
   }
 }
 
@@ -165,7 +166,6 @@ void DampingTerm::end_step(Assembler& assembler, Vec u1, double /*t1*/) {
   const std::vector<double>& local = assembler.gather(u1);
   Edot_n_.resize(cells_.size());
   E_nm1_.resize(cells_.size());
-  const bool trapezoidal = scheme_ == TimeScheme::newmark && kappa_ == 2.0;
   std::vector<int> nodes;
   Eigen::MatrixXd X, u, dN_dX;
   double sum = 0.0;
@@ -177,7 +177,7 @@ void DampingTerm::end_step(Assembler& assembler, Vec u1, double /*t1*/) {
     for (size_t q = 0; q < E1.size(); ++q) {
       Edot1[q] = kappa_ / h_ * (E1[q] - E_star_[k][q]);
       // Viscous stress of the rate that does the work: S_v(Edot) = 2 eta dev Edot + zeta tr(Edot) I.
-      const Mat3 rate = trapezoidal ? Mat3(0.5 * (Edot_n_[k][q] + Edot1[q])) : Edot1[q];
+      const Mat3 rate = trapezoidal_ ? Mat3(0.5 * (Edot_n_[k][q] + Edot1[q])) : Edot1[q];
       const Mat3 S = 2 * eta_[k] * deviator(rate) + zeta_[k] * rate.trace() * Mat3::Identity();
       const double dV = table_.points[q].weight * reference_gradients(X, table_.dN[q], dN_dX);
       sum += dV * (S.array() * (E1[q] - E_n_[k][q]).array()).sum();

@@ -26,7 +26,8 @@
 //   newmark (trapezoidal, beta = 1/4, gamma = 1/2): kappa = 2, E* = E_n + h/2 Edot_n
 //   bdf2 (variable step, w = h/h_{n-1}): kappa = alpha0 = (1 + 2w)/(1 + w),
 //        E* = -(alpha1 E_n + alpha2 E_{n-1})/alpha0, alpha1 = -(1 + w), alpha2 = w^2/(1 + w)
-// The first step (no Edot_n, E_{n-1} yet) is implicit Euler for every scheme.
+// The first step (no Edot_n, E_{n-1} yet) is implicit Euler for every scheme; a
+// bdf2 step longer than kBdf2MaxStepRatio times the last one is trapezoidal.
 // Incremental potential (dE = E(u) - E*, reference volume):
 //   D(u) = h/kappa int R(Edot) dV = kappa/h int [ eta |dev dE|^2 + zeta/2 (tr dE)^2 ] dV   [J]
 // with R = eta |dev Edot|^2 + zeta/2 (tr Edot)^2, so dD/dE = S_v(Edot) and dD/dF = F S_v
@@ -92,6 +93,7 @@ class DampingTerm : public EnergyTerm {
   ShapeTable table_;
   TimeScheme scheme_;
   double h_ = 0.0, kappa_ = 1.0, h_prev_ = 0.0;
+  bool trapezoidal_ = false;  // of the current step
   int steps_done_ = 0;
   // Per piece, per point: E_n, E*, and the history Edot_n [1/s], E_{n-1}.
   std::vector<std::vector<Mat3>> E_n_, E_star_, Edot_n_, E_nm1_;

@@ -42,12 +42,27 @@ class EnergyTerm {
   // volumes of gas-filled cavities). Default: nothing.
   virtual void prepare(const class Assembler& /*assembler*/, const std::vector<double>& /*u_local*/) {}
 
+  // Called once before each step with the converged state u0: a term whose
+  // pieces depend on the state (self-contact candidate pairs) may rebuild them and
+  // return true; the solver then rebuilds the assembly pattern. Collective.
+  virtual bool refresh_pieces(class Assembler& /*assembler*/, Vec /*u0*/) { return false; }
+
   // Step life cycle (time stepping, lagged quantities). begin_step is called
   // before every attempt of the step t0 -> t1 with the converged state u0 at t0
   // (again after a step cut); end_step once the step converged with u1. Terms
   // keep history (velocities, lagged normal forces, gas amounts) here.
   virtual void begin_step(class Assembler& /*assembler*/, Vec /*u0*/, double /*t0*/, double /*t1*/) {}
   virtual void end_step(class Assembler& /*assembler*/, Vec /*u1*/, double /*t1*/) {}
+  // After the step t0 -> t1 converged (before end_step): time-step control from a
+  // local error estimate. accept = false rejects the step (it is retried with
+  // dt_next); dt_next bounds the next step. Collective. Default: no opinion.
+  struct StepAdvice {
+    bool accept = true;
+    double dt_next = 1e300;
+  };
+  virtual StepAdvice advise_step(class Assembler& /*assembler*/, Vec /*u1*/, double /*t0*/, double /*t1*/) {
+    return {};
+  }
   // After Newton converged at t1 and before end_step: a term may update its own
   // parameters (e.g. an augmented-Lagrangian multiplier of a volume constraint)
   // and return true to ask for another solve of the same step (at most

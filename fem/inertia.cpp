@@ -206,9 +206,9 @@ void InertiaTerm::begin_step(Assembler& assembler, Vec u0, double t0, double t1)
     coeff[0] = 1.0, vecs[0] = u_n_;
     coeff[1] = h, vecs[1] = v_n_;
     count = 2;
-  } else if (opt_.scheme == TimeScheme::newmark || steps_done_ == 0) {
+  } else if (opt_.scheme == TimeScheme::newmark || steps_done_ == 0 || h > kBdf2MaxStepRatio * h_prev_) {
     // u_pred = u_n + h v_n + h^2 (1/2 - beta) a_n, c = 1/(beta h^2); the first bdf2
-    // step is trapezoidal (beta = 1/4, gamma = 1/2).
+    // step and one that grows too much are trapezoidal (beta = 1/4, gamma = 1/2).
     kind_ = StepKind::newmark;
     const bool own = opt_.scheme == TimeScheme::newmark;
     beta_ = own ? opt_.newmark_beta : 0.25;
@@ -304,6 +304,15 @@ double InertiaTerm::error_of(Assembler& assembler, Vec v1, Vec a1, double& dt_ne
   if (error > 0) factor = opt_.error_safety * std::pow(opt_.error_tolerance / error, 1.0 / (order + 1));
   dt_next = h * std::clamp(factor, opt_.error_min_factor, opt_.error_max_factor);
   return error;
+}
+
+// Accepts the step if the local error estimate is within twice the tolerance
+// (the next step aims at the tolerance itself).
+EnergyTerm::StepAdvice InertiaTerm::advise_step(Assembler& assembler, Vec u1, double, double) {
+  if (!opt_.adaptive) return {};
+  double dt_next = 1e300;
+  const double err = estimate_error(assembler, u1, dt_next);
+  return {err <= 2.0 * opt_.error_tolerance, dt_next};
 }
 
 double InertiaTerm::estimate_error(Assembler& assembler, Vec u1, double& dt_next) {

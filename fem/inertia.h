@@ -23,7 +23,10 @@
 //     (w = 1: c = 9/(4h^2), u_pred = 4/3 u_n - 1/3 u_{n-1} + 8/9 h v_n - 2/9 h v_{n-1}).
 //     Its first step has no u_{n-1}: it is one trapezoidal (Newmark 1/4, 1/2) step,
 //     second order like the rest, so quadratic motions are integrated exactly; with
-//     initial_acceleration = zero it is one implicit-Euler step instead.
+//     initial_acceleration = zero it is one implicit-Euler step instead. Variable-step
+//     BDF2 is zero-stable only for w < 1 + sqrt(2): a step that grows by more than
+//     kBdf2MaxStepRatio (e.g. right after a short step that lands on an output time)
+//     is taken as one trapezoidal step instead (one-step, second order).
 //
 //   newmark (beta, gamma; default 1/4, 1/2 = trapezoidal / average acceleration,
 //   second order, no numerical dissipation: conserves the energy of a linear
@@ -51,6 +54,7 @@
 #include <petscvec.h>
 
 #include <functional>
+#include <limits>
 #include <map>
 #include <string>
 #include <vector>
@@ -63,6 +67,8 @@
 namespace morphfem {
 
 enum class TimeScheme { implicit_euler, bdf2, newmark };
+// Largest step ratio h_n / h_{n-1} taken with the two-step BDF2 formula.
+constexpr double kBdf2MaxStepRatio = 2.0;
 // Names in one table: implicit_euler (alias bdf1), bdf2, newmark.
 const std::map<std::string, TimeScheme>& time_schemes();
 
@@ -77,6 +83,7 @@ struct InertiaOptions {
   // Local truncation error control (see suggested_dt): the largest nodal error
   // estimate allowed per step [m], and the safety factor and growth bounds.
   double error_tolerance = 1e-4;
+  bool adaptive = false;         // let the error estimate reject steps and choose dt (advise_step)
   double error_safety = 0.9, error_min_factor = 0.2, error_max_factor = 2.0;
 };
 
@@ -109,6 +116,7 @@ class InertiaTerm : public EnergyTerm {
   double piece(int k, const PieceState& s, Eigen::VectorXd* g, Eigen::MatrixXd* H) const override;
   void begin_step(Assembler& assembler, Vec u0, double t0, double t1) override;
   void end_step(Assembler& assembler, Vec u1, double t1) override;
+  StepAdvice advise_step(Assembler& assembler, Vec u1, double t0, double t1) override;
 
   // Initial velocity v_0(X) [m/s]; set before the first step.
   void set_initial_velocity(std::function<Eigen::Vector3d(const Eigen::Vector3d& X)> v0);
@@ -133,7 +141,8 @@ class InertiaTerm : public EnergyTerm {
   //   bdf2:     e = (1 + w)^2 / (6 w (1 + 2w)) h^2 (a_{n+1} - a_n)   (w = 1: 2/9)
   //   implicit_euler: e = h/2 (v_{n+1} - v_n)  (= h^2/2 u'')
   // from u''' ~ (a_{n+1} - a_n)/h; dt_next = h * clamp(safety (tol/e)^(1/(p+1)),
-  // min_factor, max_factor) with order p (1 or 2). Computed in end_step.
+  // min_factor, max_factor) with order p (1 or 2). Computed in end_step;
+  // suggested_dt() is +infinity before the first step.
   double last_error() const { return last_error_; }
   double suggested_dt() const { return suggested_dt_; }
   // The same estimate for a converged candidate u1 of the current step (begin_step
@@ -167,7 +176,7 @@ class InertiaTerm : public EnergyTerm {
   std::vector<Eigen::MatrixXd> pred_piece_;  // per piece, n x 3 [m]
   bool suppressed_ = false;  // piece() returns 0 (forces for a_0)
 
-  double last_error_ = 0.0, suggested_dt_ = 0.0;
+  double last_error_ = 0.0, suggested_dt_ = std::numeric_limits<double>::infinity();
 };
 
 }  // namespace morphfem

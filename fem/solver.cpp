@@ -68,18 +68,7 @@ QuasiStaticSolver::QuasiStaticSolver(Assembler& assembler, std::vector<Dirichlet
   PETSC_CHECK(SNESCreate(assembler_.comm(), &snes_));
   PETSC_CHECK(SNESSetType(snes_, SNESNEWTONLS));
   PETSC_CHECK(SNESSetFunction(snes_, work_, form_function, this));
-  bool any_low_rank = false;
-  for (const auto& term : assembler_.terms()) any_low_rank = any_low_rank || term->has_low_rank();
-  if (any_low_rank) {
-    // Dense low-rank Hessian parts stay out of the sparse matrix: the Newton
-    // operator is a shell H + sum c v v^T, preconditioned by (a factorisation of) H.
-    const PetscInt n_local = assembler_.owned_dof_end() - assembler_.owned_dof_begin();
-    PETSC_CHECK(MatCreateShell(assembler_.comm(), n_local, n_local, assembler_.n_dofs(), assembler_.n_dofs(), this, &J_));
-    PETSC_CHECK(MatShellSetOperation(J_, MATOP_MULT, (void (*)(void))shell_mult));
-    PETSC_CHECK(SNESSetJacobian(snes_, J_, H_, form_jacobian, this));
-  } else {
-    PETSC_CHECK(SNESSetJacobian(snes_, H_, H_, form_jacobian, this));
-  }
+  set_jacobian();
   PETSC_CHECK(SNESSetObjective(snes_, form_objective, this));
   PETSC_CHECK(SNESSetConvergenceTest(snes_, convergence_trampoline, this, nullptr));
   PETSC_CHECK(SNESSetTolerances(snes_, 0.0, 0.0, 0.0, opt_.max_newton_its, 100000));
@@ -125,6 +114,35 @@ QuasiStaticSolver::~QuasiStaticSolver() {
   VecDestroy(&u_);
   VecDestroy(&u_prev_);
   VecDestroy(&work_);
+}
+
+void QuasiStaticSolver::set_jacobian() {
+  bool any_low_rank = false;
+  for (const auto& term : assembler_.terms()) any_low_rank = any_low_rank || term->has_low_rank();
+  if (any_low_rank) {
+    // Dense low-rank Hessian parts stay out of the sparse matrix: the Newton
+    // operator is a shell H + sum c v v^T, preconditioned by (a factorisation of) H.
+    if (!J_) {
+      const PetscInt n_local = assembler_.owned_dof_end() - assembler_.owned_dof_begin();
+      PETSC_CHECK(MatCreateShell(assembler_.comm(), n_local, n_local, assembler_.n_dofs(), assembler_.n_dofs(), this, &J_));
+      PETSC_CHECK(MatShellSetOperation(J_, MATOP_MULT, (void (*)(void))shell_mult));
+    }
+    PETSC_CHECK(SNESSetJacobian(snes_, J_, H_, form_jacobian, this));
+  } else {
+    PETSC_CHECK(SNESSetJacobian(snes_, H_, H_, form_jacobian, this));
+  }
+}
+
+void QuasiStaticSolver::refresh_pieces() {
+  int changed = 0;
+  for (const auto& term : assembler_.terms()) changed |= term->refresh_pieces(assembler_, u_) ? 1 : 0;
+  int any = 0;
+  MPI_Allreduce(&changed, &any, 1, MPI_INT, MPI_LOR, assembler_.comm());
+  if (!any) return;
+  assembler_.setup();
+  PETSC_CHECK(MatDestroy(&H_));
+  H_ = assembler_.create_matrix();
+  set_jacobian();
 }
 
 void QuasiStaticSolver::clear_low_rank() {
@@ -261,6 +279,7 @@ PetscErrorCode QuasiStaticSolver::convergence(SNES, PetscInt it, PetscReal snorm
 }
 
 bool QuasiStaticSolver::solve_step(double t_new, int& newton_its, int& linear_its, std::string& why) {
+  refresh_pieces();
   // Predictor: linear extrapolation of the last increment, if it is admissible.
   PETSC_CHECK(VecCopy(u_, work_));
   const double dt = t_new - t_;
@@ -273,6 +292,12 @@ bool QuasiStaticSolver::solve_step(double t_new, int& newton_its, int& linear_it
     term->begin_step(assembler_, u_, t_, t_new);
   }
   apply_dirichlet(work_, t_new);
+  // Keep the predictor admissible (no jump through a contact surface).
+  PETSC_CHECK(VecAXPY(work_, -1.0, u_));
+  double alpha = 1.0;
+  for (const auto& term : assembler_.terms()) alpha = std::min(alpha, term->max_step(assembler_, u_, work_));
+  PETSC_CHECK(VecAYPX(work_, std::max(alpha, 0.0), u_));  // work = u + alpha (work - u)
+  apply_dirichlet(work_, t_new);  // prescribed values are never scaled
   if (!std::isfinite(assembler_.energy(work_))) {
     PETSC_CHECK(VecCopy(u_, work_));
     apply_dirichlet(work_, t_new);
@@ -302,7 +327,21 @@ bool QuasiStaticSolver::solve_step(double t_new, int& newton_its, int& linear_it
     if (!again) break;
     if (outer == opt_.max_outer_updates) reason = SNES_DIVERGED_MAX_IT;
   }
-  const bool ok = !ierr && reason > 0 && std::isfinite(assembler_.energy(x));
+  bool ok = !ierr && reason > 0 && std::isfinite(assembler_.energy(x));
+  advised_dt_ = 1e300;
+  if (ok) {
+    bool accept = true;
+    for (const auto& term : assembler_.terms()) {
+      const auto advice = term->advise_step(assembler_, x, t_, t_new);
+      accept = accept && advice.accept;
+      advised_dt_ = std::min(advised_dt_, advice.dt_next);
+    }
+    if (!accept) {
+      ok = false;
+      reason = SNES_CONVERGED_ITERATING;
+      ierr = 0;
+    }
+  }
   if (ok) {
     PETSC_CHECK(VecCopy(u_, u_prev_));
     PETSC_CHECK(VecCopy(x, u_));
@@ -310,7 +349,9 @@ bool QuasiStaticSolver::solve_step(double t_new, int& newton_its, int& linear_it
     dt_prev_ = dt;
     t_ = t_new;
   } else {
-    why = ierr ? "PETSc error during the solve" : std::string("Newton: ") + SNESConvergedReasons[reason];
+    why = ierr ? "PETSc error during the solve"
+               : reason == SNES_CONVERGED_ITERATING ? "time-step error estimate above tolerance"
+                                                    : std::string("Newton: ") + SNESConvergedReasons[reason];
     for (const auto& term : assembler_.terms()) term->set_time(t_);
   }
   VecDestroy(&x);
@@ -346,7 +387,16 @@ RunStats QuasiStaticSolver::run(const std::function<void(const StepReport&)>& on
       StepReport report{stats.steps, t_, dt_prev_, its, lits, cuts, assembler_.energy(u_)};
       if (on_step) on_step(report);
       if (its <= opt_.easy_newton_its && cuts == 0) dt = std::min(dt * opt_.grow, opt_.dt_max);
+      dt = std::min(dt, advised_dt_);
       cuts = 0;
+    } else if (why == "time-step error estimate above tolerance" && advised_dt_ < t_new - t_) {
+      ++stats.error_rejections;
+      dt = advised_dt_;
+      if (dt < opt_.dt_min) {
+        stats.failure = "step " + std::to_string(stats.steps + 1) + " from t = " + std::to_string(t_) +
+                        " s: the time-error estimate asks for a step below dt_min";
+        break;
+      }
     } else {
       ++stats.step_cuts;
       ++cuts;

@@ -54,6 +54,7 @@ struct StepReport {
 
 struct RunStats {
   int steps = 0, newton_its = 0, linear_its = 0, step_cuts = 0;
+  int error_rejections = 0;  // steps retried because a time-error estimate was too large
   double wall_s = 0;
   bool completed = false;
   std::string failure;  // diagnostic if !completed
@@ -83,6 +84,8 @@ class QuasiStaticSolver {
 
  private:
   void apply_dirichlet(Vec u, double t) const;
+  void set_jacobian();          // (re)attach the Hessian (and shell operator) to SNES
+  void refresh_pieces();        // lets terms rebuild state-dependent pieces
   bool solve_step(double t_new, int& newton_its, int& linear_its, std::string& why);
 
   Assembler& assembler_;
@@ -96,7 +99,8 @@ class QuasiStaticSolver {
   SNES snes_ = nullptr;
   double t_ = 0.0, dt_prev_ = 0.0;
   double fnorm0_ = 0.0, fnorm_scale_ = 0.0;
-  double length_scale_ = 1.0;  // diagonal of the mesh's bounding box [m]
+  double length_scale_ = 1.0;
+  double advised_dt_ = 1e300;  // smallest dt_next advised by the terms for the last attempt  // diagonal of the mesh's bounding box [m]
 };
 
 }  // namespace morphfem

@@ -10,6 +10,7 @@
 #include "app/verify_cases.h"
 #include "app/verify_hard.h"
 #include "core/errors.h"
+#include "fem/material.h"
 
 using namespace morphfem;
 
@@ -100,8 +101,11 @@ TEST(HardVerification, CookCoarseMeanDilatationWithinFivePercentAndP1Locks) {
   cook_case(quick(), PETSC_COMM_WORLD, out);
   ASSERT_EQ(out.size(), 2u);
   for (const auto& r : out) {
-    if (r.order == 1) EXPECT_LT(r.value, 0.8 * r.reference) << "P1 displacement should lock";
-    else EXPECT_LT(r.rel_error, 0.05) << r.quantity;  // measured 3.3 % on 4 divisions
+    if (r.order == 1) {
+      EXPECT_LT(r.value, 0.8 * r.reference) << "P1 displacement should lock";  // measured 3.36 of 6.91 mm
+    } else {
+      EXPECT_LT(r.rel_error, 0.05) << r.quantity;  // measured 3.3 % on 4 divisions
+    }
   }
 }
 
@@ -110,9 +114,13 @@ TEST(HardVerification, EndMomentSmallAngleMatchesTheCircle) {
   end_moment_case(quick(), PETSC_COMM_WORLD, out);
   int checked = 0;
   for (const auto& r : out) {
-    if (r.quantity.rfind("section angle", 0) == 0) EXPECT_LT(r.rel_error, 0.01) << r.quantity;
-    if (r.quantity.rfind("tip displacement error", 0) == 0) EXPECT_LT(r.value, 1e-3) << r.quantity;
-    if (r.quantity.rfind("min J", 0) == 0) EXPECT_GT(r.value, 0.0);
+    if (r.quantity.rfind("section angle", 0) == 0) {
+      EXPECT_LT(r.rel_error, 0.01) << r.quantity;
+    } else if (r.quantity.rfind("tip displacement error", 0) == 0) {
+      EXPECT_LT(r.value, 1e-3) << r.quantity;
+    } else {
+      EXPECT_GT(r.value, 0.0) << r.quantity;  // min J
+    }
     ++checked;
   }
   EXPECT_EQ(checked, 3);
