@@ -67,10 +67,10 @@ int cmd_run(const std::vector<std::string>& args) {
 }
 
 void print_table(const std::vector<morphfem::VerificationRecord>& records) {
-  std::printf("%-11s %-36s %3s %2s %9s %8s %12s %12s %9s %6s %8s %6s\n", "case", "quantity", "lvl", "P", "h [m]", "dofs",
+  std::printf("%-11s %-48s %3s %2s %9s %8s %12s %12s %9s %6s %8s %6s\n", "case", "quantity", "lvl", "P", "h [m]", "dofs",
               "value", "reference", "rel_err", "rate", "wall_s", "newton");
   for (const auto& r : records)
-    std::printf("%-11s %-36s %3d %2d %9.3g %8ld %12.6g %12.6g %9.2e %6s %8.2f %6d\n", r.case_name.c_str(),
+    std::printf("%-11s %-48s %3d %2d %9.3g %8ld %12.6g %12.6g %9.2e %6s %8.2f %6d\n", r.case_name.c_str(),
                 r.quantity.c_str(), r.level, r.order, r.h, r.dofs, r.value, r.reference, r.rel_error,
                 r.rate != 0 ? std::to_string(r.rate).substr(0, 5).c_str() : "-", r.wall_s, r.newton_its);
 }

@@ -236,13 +236,29 @@ double cylinder_pressure(double la, double ratio) {
 }
 
 void cylinder_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<VerificationRecord>& out) {
-  const double A = 0.01, B = 0.02, mu = 1e5, kappa = 1000 * mu;
+  const double A = 0.01, B = 0.02, mu = 1e5;
   const double p_over_mu = 0.574054;  // VERIFICATION.md case 4, A/B = 0.5, la = 2.0
   std::vector<double> sizes = opt.quick ? std::vector<double>{A / 2} : std::vector<double>{A / 2, A / 4, A / 8};
   std::vector<int> orders = opt.quick ? std::vector<int>{2} : std::vector<int>{1, 2};
+  // Runs: every (order, level) at kappa = 1000 mu; on the finest P2 level also
+  // kappa = 100 mu and 10000 mu, to show how much of the error compressibility explains.
+  struct Run {
+    int order;
+    size_t level;
+    double kappa_ratio;
+  };
+  std::vector<Run> runs;
   for (int order : orders)
-    for (size_t level = 0; level < sizes.size(); ++level) {
-      const double h = sizes[level];
+    for (size_t level = 0; level < sizes.size(); ++level) runs.push_back({order, level, 1000.0});
+  if (!opt.quick) {
+    runs.push_back({2, sizes.size() - 1, 100.0});
+    runs.push_back({2, sizes.size() - 1, 10000.0});
+  }
+  for (const Run& run : runs) {
+      const int order = run.order;
+      const size_t level = run.level;
+      const double h = sizes[level], kappa = run.kappa_ratio * mu;
+      const std::string suffix = run.kappa_ratio == 1000.0 ? "" : " (kappa/mu=" + std::to_string(int(run.kappa_ratio)) + ")";
       Scene s = verification_scene("cylinder", verification_params({{"inner_radius", A}, {"outer_radius", B}, {"mesh_size", h},
                                                {"order", double(order)}}, "type", "thick_cylinder"),
                            verification_params({{"mu", mu}, {"kappa", kappa}}, "model", "neo_hookean"));
@@ -273,12 +289,12 @@ void cylinder_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<Verifica
         sum += std::hypot(x[0], x[1]);
       }
       const double la = sum / vertices.size() / A;
-      auto rec = verification_record("cylinder", "P/mu at computed inner stretch", int(level), order, h, r);
+      auto rec = verification_record("cylinder", "P/mu at computed inner stretch" + suffix, int(level), order, h, r);
       rec.value = p_over_mu;
       rec.reference = cylinder_pressure(la, A / B);
       rec.rel_error = std::abs(rec.value - rec.reference) / rec.reference;
       out.push_back(rec);
-      auto srec = verification_record("cylinder", "inner stretch (reference 2.0)", int(level), order, h, r);
+      auto srec = verification_record("cylinder", "inner stretch (reference 2.0)" + suffix, int(level), order, h, r);
       srec.value = la;
       srec.reference = 2.0;
       srec.rel_error = std::abs(la - 2.0) / 2.0;
@@ -339,6 +355,51 @@ void cantilever_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<Verifi
   }
 }
 
+// -------------------------------------------- case 8: block sliding down a slope
+// Coulomb friction mu = 0.49 on a slope atan(0.5), g = 9.8 (gravity tilted):
+// s(t) = a t^2 / 2, a = g (sin - mu cos) = 0.087654 m/s^2, s(2.5 s) = 0.27392 m.
+// A time-step ladder with implicit Euler (first order); the block is stiff so its
+// deformation does not add to the slide.
+void slope_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<VerificationRecord>& out) {
+  const double g = 9.8, slope = std::atan(0.5), mu = 0.49, T = 2.5;
+  const double reference = 0.5 * g * (std::sin(slope) - mu * std::cos(slope)) * T * T;
+  const double L = 0.02, dhat = 1e-5;
+  std::vector<double> steps = opt.quick ? std::vector<double>{0.05, 0.025} : std::vector<double>{0.05, 0.025, 0.0125};
+  double prev_error = 0, prev_dt = 0;
+  for (size_t level = 0; level < steps.size(); ++level) {
+    const double dt = steps[level];
+    Scene s = verification_scene("slope", verification_params({{"lx", L}, {"ly", L}, {"lz", L}, {"mesh_size", L / 2},
+                                                               {"order", 1}}, "type", "block"),
+                                 verification_params({{"mu", 1e7}, {"nu", 0.3}, {"density", 1000}}, "model", "neo_hookean"));
+    s.gravity = Eigen::Vector3d(g * std::sin(slope), 0, -g * std::cos(slope));
+    s.dynamic = true;
+    s.inertia.scheme = TimeScheme::implicit_euler;
+    s.ground_contact = true;
+    s.ground.surfaces = {"zmin"};
+    s.ground.dhat = dhat;
+    s.ground.point = Eigen::Vector3d(0, 0, -0.9985 * dhat);  // the resting barrier gap under the weight
+    s.friction = true;
+    s.friction_spec.eps_v = 1e-4;
+    s.friction_spec.regions.push_back({"zmin", TimeFunction::constant(mu), TimeFunction::constant(mu)});
+    s.solver.t_end = T;
+    s.solver.dt_initial = s.solver.dt_max = dt;
+    auto r = run_scene(s, comm, {false, opt.progress, {}});
+    require_completed(r, "block on a slope");
+    double slide = 0;
+    for (int n = 0; n < r.mesh.n_nodes(); ++n) slide += r.u(n, 0);
+    slide /= r.mesh.n_nodes();
+    auto rec = verification_record("slope", "slide s(2.5 s) [m], dt=" + std::to_string(dt).substr(0, 6), int(level), 1,
+                                   L / 2, r);
+    rec.value = slide;
+    rec.reference = reference;
+    rec.rel_error = std::abs(slide - reference) / reference;
+    if (level > 0) rec.rate = std::log(prev_error / rec.rel_error) / std::log(prev_dt / dt);
+    prev_error = rec.rel_error;
+    prev_dt = dt;
+    out.push_back(rec);
+  }
+}
+
 struct CaseEntry {
   VerificationCase run;
   bool hard;
@@ -351,6 +412,7 @@ const std::map<std::string, CaseEntry>& cases() {
       {"mms", {mms_case, false}},
       {"cylinder", {cylinder_case, false}},
       {"cantilever", {cantilever_case, false}},
+      {"slope", {slope_case, false}},
   };
   return registry;
 }

@@ -331,6 +331,7 @@ void incompressible_block_case(const VerifyOptions& opt, MPI_Comm comm, std::vec
   std::map<std::string, std::vector<std::pair<SimulationResult, double>>> runs;
   for (const std::string formulation : {"mean_dilatation", "displacement"})
     for (int n : divisions) {
+      if (formulation == "displacement" && n > 4) continue;  // locks; 109 s at n = 6 for no new information
       const double h = L / n;
       Scene s = verification_scene("block_shear",
                                    verification_params({{"lx", L}, {"ly", L}, {"lz", L}, {"mesh_size", h}, {"order", 2},
@@ -363,7 +364,6 @@ void incompressible_block_case(const VerifyOptions& opt, MPI_Comm comm, std::vec
       rec.value = ux;
       rec.reference = reference;
       rec.rel_error = rel_error(ux, reference);
-      rec.reference = reference;
       out.push_back(rec);
       auto jrec = verification_record("incompressible_block", "bonded cube, top shear: min J (" + formulation + ")",
                                       int(level), 2, L / divisions[level], r);
@@ -419,11 +419,23 @@ void compression_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<Verif
     out.push_back(jrec);
   }
   // (2) bonded
-  const std::vector<int> divisions = opt.quick ? std::vector<int>{2} : std::vector<int>{2, 4, 8};
+  const std::vector<int> divisions = opt.quick ? std::vector<int>{2} : std::vector<int>{2, 3, 4};
   std::vector<std::pair<SimulationResult, double>> runs;
-  for (int n : divisions) {
-    auto r = run_scene(scene(L / n, true), comm, {false, opt.progress, {}});
-    require_completed(r, "compression, bonded, " + std::to_string(n) + " divisions");
+  for (size_t level = 0; level < divisions.size(); ++level) {
+    auto r = run_scene(scene(L / divisions[level], true), comm, {false, opt.progress, {}});
+    if (!r.stats.completed) {
+      // Recorded, not thrown: how far the compression got (fraction of the 50 %)
+      // before the solver gave up (typically a corner cell at a bonded edge folding).
+      const auto top = r.mesh.nodes_of_surface("zmax");
+      auto rec = verification_record("compression", "bonded 50 %: FAILED, fraction of the compression reached (" +
+                                                        r.stats.failure + ")",
+                                     int(level), 2, L / divisions[level], r);
+      rec.value = -r.u(top[0], 2) / (0.5 * L);
+      rec.reference = 1.0;
+      rec.rel_error = rel_error(rec.value, 1.0);
+      out.push_back(rec);
+      break;
+    }
     const double force = elastic_reaction(r.mesh, r.u, formulation, law, r.mesh.nodes_of_surface("zmax"), 2);
     runs.push_back({r, force});
   }

@@ -54,3 +54,10 @@ TEST(Verification, UnknownCaseIsAnInputError) {
   options.cases = {"nonsense"};
   EXPECT_THROW(run_verification(options, PETSC_COMM_WORLD), std::exception);
 }
+
+TEST(Verification, BlockOnSlopeSlidesThePredictedDistanceWithFirstOrderTimeError) {
+  auto records = run("slope");
+  ASSERT_EQ(records.size(), 2u);
+  for (const auto& r : records) EXPECT_LT(r.rel_error, 0.02) << r.quantity;
+  EXPECT_NEAR(records[1].rate, 1.0, 0.3);  // implicit Euler
+}
