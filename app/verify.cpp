@@ -8,6 +8,7 @@
 
 #include "app/simulation.h"
 #include "app/verify_cases.h"
+#include "app/verify_hard.h"
 #include "core/errors.h"
 #include "core/json.h"
 #include "fem/element.h"
@@ -413,6 +414,12 @@ const std::map<std::string, CaseEntry>& cases() {
       {"cylinder", {cylinder_case, false}},
       {"cantilever", {cantilever_case, false}},
       {"slope", {slope_case, false}},
+      // The hard-case suite (morphfem verify --hard): near-incompressibility,
+      // large compression and rotation, limit points.
+      {"cook", {cook_case, true}},
+      {"incompressible_block", {incompressible_block_case, true}},
+      {"compression", {compression_case, true}},
+      {"end_moment", {end_moment_case, true}},
   };
   return registry;
 }

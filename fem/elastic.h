@@ -44,7 +44,8 @@ class ElasticTerm : public EnergyTerm {
 };
 
 // Element formulations of the elastic energy, registered by name in one table
-// (elastic.cpp): "displacement" (pure displacement, this file). Scenes choose one
+// (elastic.cpp): "displacement" (pure displacement, this file) and
+// "mean_dilatation" (P2/P0 locking-free, fem/mean_dilatation.h). Scenes choose one
 // with `solver: {formulation: NAME}`.
 using ElasticTermFactory = std::function<std::shared_ptr<ElasticTerm>(
     const Mesh&, const Partition&, int rank, std::vector<std::shared_ptr<const Material>>, int quadrature_degree)>;
