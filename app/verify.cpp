@@ -401,6 +401,62 @@ void slope_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<Verificatio
   }
 }
 
+// ------------------------------- friction that switches on a schedule (issue 4)
+// A block on a slope atan(0.5): mu = 0.9 (sticks) until t = 1 s, 0.2 (slides,
+// a1 = g (sin - 0.2 cos)) until t = 2 s, then 0.9 again (decelerates with
+// a2 = g (sin - 0.9 cos) < 0 until it stops). Exact slide:
+// s = a1/2 (1 s)^2 + (a1 * 1 s)^2 / (2 |a2|); no motion before t = 1 s.
+void friction_switch_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<VerificationRecord>& out) {
+  const double g = 9.8, slope = std::atan(0.5), L = 0.02, dhat = 1e-5, T = 3.0;
+  const double a1 = g * (std::sin(slope) - 0.2 * std::cos(slope)), a2 = g * (std::sin(slope) - 0.9 * std::cos(slope));
+  const double reference = 0.5 * a1 + a1 * a1 / (2 * std::abs(a2));
+  const TimeFunction mu({{0.0, 0.9}, {1.0, 0.9}, {1.0 + 1e-6, 0.2}, {2.0, 0.2}, {2.0 + 1e-6, 0.9}});
+  std::vector<double> steps = opt.quick ? std::vector<double>{0.02} : std::vector<double>{0.02, 0.01, 0.005};
+  double prev_error = 0, prev_dt = 0;
+  for (size_t level = 0; level < steps.size(); ++level) {
+    const double dt = steps[level];
+    Scene s = verification_scene("friction_switch",
+                                 verification_params({{"lx", L}, {"ly", L}, {"lz", L}, {"mesh_size", L / 2}, {"order", 1}},
+                                                     "type", "block"),
+                                 verification_params({{"mu", 1e7}, {"nu", 0.3}, {"density", 1000}}, "model", "neo_hookean"));
+    s.gravity = Eigen::Vector3d(g * std::sin(slope), 0, -g * std::cos(slope));
+    s.dynamic = true;
+    s.inertia.scheme = TimeScheme::implicit_euler;
+    s.ground_contact = true;
+    s.ground.surfaces = {"zmin"};
+    s.ground.dhat = dhat;
+    s.ground.point = Eigen::Vector3d(0, 0, -0.9985 * dhat);
+    s.friction = true;
+    s.friction_spec.eps_v = 1e-5;  // stick creep ~ eps_v (1 - sqrt(1 - q)) per second, q = load / (mu N)
+    s.friction_spec.regions.push_back({"zmin", mu, mu});
+    s.solver.t_end = T;
+    s.solver.dt_initial = s.solver.dt_max = dt;
+    s.solver.output_times = {1.0, 2.0};
+    double slide_at_1 = 0;
+    RunOptions run{false, opt.progress, {}};
+    run.on_step = [&](double t, const Mesh& mesh, const RowMatrixXd& u, const SimulationResult&) {
+      if (std::abs(t - 1.0) < 1e-9) slide_at_1 = u.col(0).mean();
+    };
+    auto r = run_scene(s, comm, run);
+    require_completed(r, "friction switch");
+    const double slide = r.u.col(0).mean();
+    auto rec = verification_record("friction_switch", "slide [m] over 3 s, dt=" + std::to_string(dt).substr(0, 5),
+                                   int(level), 1, L / 2, r);
+    rec.value = slide;
+    rec.reference = reference;
+    rec.rel_error = std::abs(slide - reference) / reference;
+    if (level > 0) rec.rate = std::log(prev_error / rec.rel_error) / std::log(prev_dt / dt);
+    prev_error = rec.rel_error;
+    prev_dt = dt;
+    out.push_back(rec);
+    auto still = verification_record("friction_switch", "creep [m] while mu = 0.9 (t < 1 s)", int(level), 1, L / 2, r);
+    still.value = slide_at_1;
+    still.reference = 0;
+    still.rel_error = std::abs(slide_at_1) / L;  // relative to the block size
+    out.push_back(still);
+  }
+}
+
 struct CaseEntry {
   VerificationCase run;
   bool hard;
@@ -414,6 +470,7 @@ const std::map<std::string, CaseEntry>& cases() {
       {"cylinder", {cylinder_case, false}},
       {"cantilever", {cantilever_case, false}},
       {"slope", {slope_case, false}},
+      {"friction_switch", {friction_switch_case, false}},
       // The hard-case suite (morphfem verify --hard): near-incompressibility,
       // large compression and rotation, limit points.
       {"cook", {cook_case, true}},

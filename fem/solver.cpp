@@ -252,11 +252,21 @@ PetscErrorCode QuasiStaticSolver::line_search(SNESLineSearch ls) {
   return 0;
 }
 
+namespace {
+bool full_newton_step(SNES snes) {
+  SNESLineSearch ls;
+  PetscReal lambda = 0;
+  if (SNESGetLineSearch(snes, &ls) || SNESLineSearchGetLambda(ls, &lambda)) return false;
+  return lambda == 1.0;
+}
+}  // namespace
+
 // Converged when the residual [N] fell by rtol, or is below atol_factor times the
-// largest initial residual of the run, or when the Newton update is at round-off
-// level (RMS below 1e-13 of the body's size) after the residual fell by 1e6:
-// then the residual is as small as double precision can make it.
-PetscErrorCode QuasiStaticSolver::convergence(SNES, PetscInt it, PetscReal snorm, PetscReal fnorm,
+// largest initial residual of the run, or when a full (undamped) Newton update is
+// at round-off level (RMS below 1e-13 of the body's size): the linearisation then
+// says the state is the solution to double precision, and the residual cannot
+// fall further.
+PetscErrorCode QuasiStaticSolver::convergence(SNES snes, PetscInt it, PetscReal snorm, PetscReal fnorm,
                                               SNESConvergedReason* reason) {
   *reason = SNES_CONVERGED_ITERATING;
   if (it == 0) {
@@ -269,7 +279,7 @@ PetscErrorCode QuasiStaticSolver::convergence(SNES, PetscInt it, PetscReal snorm
     *reason = SNES_CONVERGED_FNORM_ABS;
   } else if (it > 0 && fnorm <= opt_.rtol * fnorm0_) {
     *reason = SNES_CONVERGED_FNORM_RELATIVE;
-  } else if (it > 0 && fnorm <= 1e-6 * fnorm0_ &&
+  } else if (it > 0 && full_newton_step(snes) &&
              snorm <= 1e-13 * length_scale_ * std::sqrt(double(assembler_.n_dofs()))) {
     *reason = SNES_CONVERGED_SNORM_RELATIVE;
   } else if (it >= opt_.max_newton_its) {

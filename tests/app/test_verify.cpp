@@ -61,3 +61,10 @@ TEST(Verification, BlockOnSlopeSlidesThePredictedDistanceWithFirstOrderTimeError
   for (const auto& r : records) EXPECT_LT(r.rel_error, 0.02) << r.quantity;
   EXPECT_NEAR(records[1].rate, 1.0, 0.3);  // implicit Euler
 }
+
+TEST(Verification, FrictionSwitchingOnAScheduleMovesOnlyWhenLow) {
+  auto records = run("friction_switch");
+  ASSERT_EQ(records.size(), 2u);
+  EXPECT_LT(records[0].rel_error, 0.05) << records[0].quantity;  // predicted slide within 5 %
+  EXPECT_LT(records[1].rel_error, 1e-3) << records[1].quantity;  // creep below 0.1 % of the block size
+}
