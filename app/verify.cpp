@@ -8,6 +8,7 @@
 
 #include "app/simulation.h"
 #include "app/verify_cases.h"
+#include "app/verify_gas.h"
 #include "app/verify_hard.h"
 #include "core/errors.h"
 #include "core/json.h"
@@ -477,6 +478,12 @@ const std::map<std::string, CaseEntry>& cases() {
       {"incompressible_block", {incompressible_block_case, true}},
       {"compression", {compression_case, true}},
       {"end_moment", {end_moment_case, true}},
+      // Limit points: gas- and volume-controlled cavities, the valve model.
+      {"gas_sphere", {gas_thick_sphere_case, true}},
+      {"gas_balloon", {gas_balloon_case, true}},
+      {"gas_mooney_balloon", {gas_mooney_balloon_case, true}},
+      {"pressure_past_limit", {gas_pressure_control_failure_case, true}},
+      {"valve", {gas_valve_case, true}},
   };
   return registry;
 }

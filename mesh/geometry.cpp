@@ -26,6 +26,7 @@
 #include <stdexcept>
 
 #include "core/errors.h"
+#include "mesh/robot.h"
 
 namespace morphfem {
 
@@ -371,6 +372,8 @@ const std::map<std::string, GeometryBuilder>& geometry_registry() {
       {"spherical_shell", build_spherical_shell},
       {"cook_membrane", build_cook_membrane},
       {"cantilever", build_cantilever},
+      {"robot_voxel", build_robot_voxel},
+      {"robot_physical", build_robot_physical},
   };
   return registry;
 }

@@ -1,0 +1,353 @@
+// Robot geometries (see robot.h): an assembly of axis-aligned boxes, each labelled with
+// its volume region, joined by OCC boolean fragments; cavities are the empty boxes the
+// pieces enclose. Surfaces are named after meshing from a representative triangle of
+// each boundary surface entity: inside a cavity box -> that cavity's wall; outward
+// normal -z -> bottom (and a foot if it is the skin's bottom face in a foot band);
+// otherwise outer.
+#include "mesh/robot.h"
+
+#include <gmsh.h>
+
+#include <algorithm>
+#include <limits>
+#include <map>
+#include <stdexcept>
+
+#include "core/errors.h"
+#include "mesh/geometry.h"
+
+namespace morphfem {
+
+namespace {
+
+using Vec3 = Eigen::Vector3d;
+
+constexpr double kHuge = std::numeric_limits<double>::max();
+constexpr int kBladders = 8;
+
+struct AxisBox {
+  Vec3 lo, hi;
+  bool contains(const Vec3& p, double tol) const {
+    return (p.array() >= lo.array() - tol).all() && (p.array() <= hi.array() + tol).all();
+  }
+};
+
+AxisBox axis_box(double x0, double x1, double y0, double y1, double z0, double z1) {
+  return {Vec3(x0, y0, z0), Vec3(x1, y1, z1)};
+}
+
+struct Piece {
+  AxisBox box;
+  std::string region;
+};
+
+struct Cavity {
+  AxisBox box;
+  std::string surface;  // name of its wall (surface region)
+};
+
+struct Assembly {
+  std::vector<Piece> pieces;       // solid boxes, touching but not overlapping
+  std::vector<Cavity> cavities;    // closed empty boxes enclosed by the pieces
+  std::vector<std::string> volume_order;   // volume regions in group order
+  double length = 0.0;             // body length along y
+  double foot_length = 0.0;        // feet: y in [0, foot_length] and [length - foot_length, length]
+  double foot_z = 0.0;             // z of the skin's bottom face (the feet plane)
+  double scale = 0.0;              // largest body dimension (for tolerances)
+};
+
+// A fresh gmsh model for one build, removed when the scope ends (also on errors).
+class ScopedModel {
+ public:
+  explicit ScopedModel(const std::string& name) {
+    initialize_gmsh();
+    gmsh::model::add(name);
+  }
+  ~ScopedModel() { gmsh::model::remove(); }
+  ScopedModel(const ScopedModel&) = delete;
+  ScopedModel& operator=(const ScopedModel&) = delete;
+};
+
+// Representative point (centroid of the first triangle) and node box of a meshed surface.
+struct SurfaceSample {
+  Vec3 point = Vec3::Zero();
+  int axis = 2;  // the coordinate axis the (planar, axis-aligned) surface is normal to
+  AxisBox nodes{Vec3::Constant(kHuge), Vec3::Constant(-kHuge)};
+};
+
+Vec3 node_coordinates(std::size_t tag) {
+  std::vector<double> coord, parametric;
+  int dim = 0, entity = 0;
+  gmsh::model::mesh::getNode(tag, coord, parametric, dim, entity);
+  return Vec3(coord[0], coord[1], coord[2]);
+}
+
+SurfaceSample sample_surface(int tag) {
+  SurfaceSample s;
+  std::vector<int> types;
+  std::vector<std::vector<std::size_t>> element_tags, node_tags;
+  gmsh::model::mesh::getElements(types, element_tags, node_tags, 2, tag);
+  if (types.empty() || node_tags[0].size() < 3) throw std::logic_error("robot geometry: an unmeshed surface");
+  const Vec3 a = node_coordinates(node_tags[0][0]), b = node_coordinates(node_tags[0][1]),
+             c = node_coordinates(node_tags[0][2]);
+  s.point = (a + b + c) / 3.0;
+  (b - a).cross(c - a).cwiseAbs().maxCoeff(&s.axis);
+
+  std::vector<std::size_t> tags;
+  std::vector<double> coords, parametric;
+  gmsh::model::mesh::getNodes(tags, coords, parametric, 2, tag, true, false);
+  for (std::size_t k = 0; k < tags.size(); ++k) {
+    const Vec3 x(coords[3 * k], coords[3 * k + 1], coords[3 * k + 2]);
+    s.nodes.lo = s.nodes.lo.cwiseMin(x);
+    s.nodes.hi = s.nodes.hi.cwiseMax(x);
+  }
+  return s;
+}
+
+bool inside_solid(const Assembly& assembly, const Vec3& p) {
+  return std::any_of(assembly.pieces.begin(), assembly.pieces.end(),
+                     [&](const Piece& piece) { return piece.box.contains(p, 0.0); });
+}
+
+// Meshes the synchronized model in 3-D with target size h and the element order.
+void generate_mesh(double mesh_size, int order) {
+  gmsh::option::setNumber("Mesh.MeshSizeMin", 0.0);
+  gmsh::option::setNumber("Mesh.MeshSizeMax", mesh_size);
+  gmsh::option::setNumber("Mesh.MeshSizeFromCurvature", 0);
+  gmsh::option::setNumber("Mesh.ElementOrder", order);
+  gmsh::option::setNumber("Mesh.SecondOrderLinear", 0);
+  gmsh::option::setNumber("Mesh.HighOrderOptimize", 0);
+  gmsh::option::setNumber("Mesh.Algorithm3D", 1);  // Delaunay: deterministic, single-threaded
+  gmsh::vectorpair points;
+  gmsh::model::getEntities(points, 0);
+  gmsh::model::mesh::setSize(points, mesh_size);
+  gmsh::model::mesh::generate(3);
+}
+
+void add_group(int dim, const std::vector<int>& tags, const std::string& name) {
+  if (tags.empty()) throw std::logic_error("robot geometry: empty region " + name);
+  gmsh::model::setPhysicalName(dim, gmsh::model::addPhysicalGroup(dim, tags), name);
+}
+
+Mesh mesh_assembly(const Assembly& assembly, double mesh_size, int order, const std::string& source) {
+  ScopedModel model("morphfem_robot");
+  namespace occ = gmsh::model::occ;
+  gmsh::vectorpair boxes;
+  for (const Piece& piece : assembly.pieces) {
+    const Vec3 size = piece.box.hi - piece.box.lo;
+    boxes.emplace_back(3, occ::addBox(piece.box.lo.x(), piece.box.lo.y(), piece.box.lo.z(), size.x(), size.y(),
+                                      size.z()));
+  }
+  gmsh::vectorpair fragments;
+  std::vector<gmsh::vectorpair> unused_map;
+  occ::fragment({boxes.front()}, gmsh::vectorpair(boxes.begin() + 1, boxes.end()), fragments, unused_map);
+  occ::synchronize();
+  generate_mesh(mesh_size, order);
+
+  const double tol = 1e-9 * assembly.scale, probe = 1e-6 * assembly.scale;
+
+  // Volumes: the piece containing each fragment's centre of mass gives its region.
+  std::map<std::string, std::vector<int>> volume_tags;
+  gmsh::vectorpair volumes;
+  gmsh::model::getEntities(volumes, 3);
+  for (const auto& [dim, tag] : volumes) {
+    double x, y, z;
+    occ::getCenterOfMass(dim, tag, x, y, z);
+    auto piece = std::find_if(assembly.pieces.begin(), assembly.pieces.end(),
+                              [&](const Piece& p) { return p.box.contains(Vec3(x, y, z), tol); });
+    if (piece == assembly.pieces.end()) throw std::logic_error("robot geometry: a fragment lies in no piece");
+    volume_tags[piece->region].push_back(tag);
+  }
+  for (const std::string& name : assembly.volume_order) add_group(3, volume_tags[name], name);
+
+  // Boundary surfaces (one adjacent volume).
+  std::map<std::string, std::vector<int>> surface_tags;
+  gmsh::vectorpair surfaces;
+  gmsh::model::getEntities(surfaces, 2);
+  for (const auto& [dim, tag] : surfaces) {
+    std::vector<int> up, down;
+    gmsh::model::getAdjacencies(dim, tag, up, down);
+    if (up.size() != 1) continue;
+    const SurfaceSample s = sample_surface(tag);
+    auto cavity = std::find_if(assembly.cavities.begin(), assembly.cavities.end(),
+                               [&](const Cavity& c) { return c.box.contains(s.point, tol); });
+    if (cavity != assembly.cavities.end()) {
+      surface_tags[cavity->surface].push_back(tag);
+      continue;
+    }
+    Vec3 step = Vec3::Zero();
+    step(s.axis) = probe;
+    const bool solid_below = inside_solid(assembly, s.point - step), solid_above = inside_solid(assembly, s.point + step);
+    if (solid_below == solid_above) throw std::logic_error("robot geometry: cannot orient a boundary surface");
+    const bool faces_down = s.axis == 2 && solid_above;
+    if (!faces_down) {
+      surface_tags["outer"].push_back(tag);
+      continue;
+    }
+    surface_tags["bottom"].push_back(tag);
+    if (std::abs(s.nodes.hi.z() - assembly.foot_z) > tol || std::abs(s.nodes.lo.z() - assembly.foot_z) > tol) continue;
+    if (s.nodes.hi.y() <= assembly.foot_length + tol) surface_tags["foot_a"].push_back(tag);
+    if (s.nodes.lo.y() >= assembly.length - assembly.foot_length - tol) surface_tags["foot_b"].push_back(tag);
+  }
+  std::vector<std::string> surface_order;
+  for (const Cavity& c : assembly.cavities) surface_order.push_back(c.surface);
+  for (const char* name : {"bottom", "foot_a", "foot_b", "outer"}) surface_order.push_back(name);
+  for (const std::string& name : surface_order) add_group(2, surface_tags[name], name);
+
+  return mesh_from_current_gmsh_model(source);
+}
+
+// Reads a length with a default, in (0, inf).
+double length_param(const ParamSet& params, const std::string& key, double fallback) {
+  return params.number_in(key, 1e-9, kHuge, fallback);
+}
+
+void require(bool ok, const ParamSet& params, const std::string& key, const std::string& message) {
+  if (!ok) throw InputError(params.where(key), message);
+}
+
+// x range of bladder column c = 0..3 (increasing x): columns of width bw evenly spaced
+// over [0, width], the outer ones flush with the edges.
+std::pair<double, double> column_x(int c, double width, double bw) {
+  const double pitch = (width - bw) / 3.0;
+  return {c * pitch, c * pitch + bw};
+}
+
+// Top bladders 1..4 over columns 0..3, bottom bladders 5..8 over columns 3..0.
+int bladder_column(int k) { return k <= 4 ? k - 1 : kBladders - k; }
+
+std::string bladder_name(int k) { return "bladder_" + std::to_string(k); }
+
+// A layer [0, width] x [0, length] x [z0, z1], split at the foot bands' inner ends.
+void add_split_layer(Assembly& a, double width, double z0, double z1, const std::string& region) {
+  const double f = a.foot_length, l = a.length;
+  a.pieces.push_back({axis_box(0, width, 0, f, z0, z1), region});
+  a.pieces.push_back({axis_box(0, width, f, l - f, z0, z1), region});
+  a.pieces.push_back({axis_box(0, width, l - f, l, z0, z1), region});
+}
+
+// The core gap z in [z0, z1]: solid bonded strips along x = 0 and x = width (edge wide),
+// end seals at y = 0 and y = length (seal wide), and the cavity between them.
+void add_core(Assembly& a, double width, double edge, double seal, double z0, double z1) {
+  const double l = a.length;
+  a.pieces.push_back({axis_box(0, edge, 0, l, z0, z1), "skin"});
+  a.pieces.push_back({axis_box(width - edge, width, 0, l, z0, z1), "skin"});
+  a.pieces.push_back({axis_box(edge, width - edge, 0, seal, z0, z1), "skin"});
+  a.pieces.push_back({axis_box(edge, width - edge, l - seal, l, z0, z1), "skin"});
+  a.cavities.push_back({axis_box(edge, width - edge, seal, l - seal, z0, z1), "core_wall"});
+}
+
+struct CommonRobot {
+  double mesh_size = 0.0;
+  int order = 1;
+  double width = 0.0, length = 0.0, core_gap = 0.0, edge = 0.0, seal = 0.0;
+  double bladder_thickness = 0.0, bladder_width = 0.0, foot_length = 0.0;
+};
+
+CommonRobot common_robot(const ParamSet& params, double width, double length, double core_gap, double edge,
+                         double seal, double bladder_thickness, double bladder_width, double foot_length) {
+  CommonRobot c;
+  c.mesh_size = params.number_in("mesh_size", 1e-12, kHuge);
+  c.order = params.integer_in("order", 1, 2, 1);
+  c.width = length_param(params, "width", width);
+  c.length = length_param(params, "length", length);
+  c.core_gap = length_param(params, "core_gap", core_gap);
+  c.edge = length_param(params, "edge_width", edge);
+  c.seal = length_param(params, "end_seal", seal);
+  c.bladder_thickness = length_param(params, "bladder_thickness", bladder_thickness);
+  c.bladder_width = length_param(params, "bladder_width", bladder_width);
+  c.foot_length = length_param(params, "foot_length", foot_length);
+  require(2 * c.edge < c.width, params, "edge_width", "the two bonded edges must leave a core: 2 edge_width < width");
+  require(2 * c.seal < c.length, params, "end_seal", "the two end seals must leave a core: 2 end_seal < length");
+  require(4 * c.bladder_width <= c.width, params, "bladder_width", "four bladder columns must fit: 4 bladder_width <= width");
+  require(2 * c.foot_length < c.length, params, "foot_length", "the feet must not meet: 2 foot_length < length");
+  return c;
+}
+
+std::vector<std::string> volume_order(bool with_fabric) {
+  std::vector<std::string> order = {"skin"};
+  if (with_fabric) order.push_back("fabric");
+  for (int k = 1; k <= kBladders; ++k) order.push_back(bladder_name(k));
+  return order;
+}
+
+}  // namespace
+
+Mesh build_robot_voxel(const ParamSet& params) {
+  params.allow_only({"type", "mesh_size", "order", "width", "length", "layer_thickness", "core_gap", "edge_width",
+                     "end_seal", "bladder_thickness", "bladder_width", "bladder_start", "bladder_end",
+                     "foot_length"});
+  const CommonRobot c = common_robot(params, 0.15, 0.22, 0.002, 0.01, 0.01, 0.02, 0.03, 0.03);
+  const double t = length_param(params, "layer_thickness", 0.01);
+  const double y0 = params.number_in("bladder_start", 0.0, c.length, 0.03);
+  const double y1 = params.number_in("bladder_end", 0.0, c.length, 0.19);
+  require(y0 < y1, params, "bladder_end", "bladder_end must exceed bladder_start");
+
+  Assembly a;
+  a.length = c.length;
+  a.foot_length = c.foot_length;
+  a.volume_order = volume_order(false);
+  const double hb = c.bladder_thickness;
+  const double z_core = hb + t, z_top = z_core + c.core_gap, z_upper = z_top + t;
+  a.foot_z = hb;
+  a.scale = std::max({c.width, c.length, z_upper + hb});
+  add_split_layer(a, c.width, hb, z_core, "skin");
+  add_core(a, c.width, c.edge, c.seal, z_core, z_top);
+  a.pieces.push_back({axis_box(0, c.width, 0, c.length, z_top, z_upper), "skin"});
+  for (int k = 1; k <= kBladders; ++k) {
+    const auto [x0, x1] = column_x(bladder_column(k), c.width, c.bladder_width);
+    const double z0 = k <= 4 ? z_upper : 0.0;
+    a.pieces.push_back({axis_box(x0, x1, y0, y1, z0, z0 + hb), bladder_name(k)});
+  }
+  return mesh_assembly(a, c.mesh_size, c.order, params.context().empty() ? "geometry robot_voxel" : params.context());
+}
+
+Mesh build_robot_physical(const ParamSet& params) {
+  params.allow_only({"type", "mesh_size", "order", "width", "length", "skin_thickness", "fabric_thickness",
+                     "core_gap", "edge_width", "end_seal", "bladder_thickness", "bladder_wall", "bladder_width",
+                     "foot_length"});
+  const CommonRobot c = common_robot(params, 0.10, 0.15, 0.001, 0.005, 0.005, 0.003, 0.02, 0.02);
+  const double t = length_param(params, "skin_thickness", 0.003);
+  const double tf = length_param(params, "fabric_thickness", 0.0005);
+  const double w = length_param(params, "bladder_wall", 0.0008);
+  require(tf < t, params, "fabric_thickness", "the fabric must be thinner than the skin layer");
+  require(2 * w < std::min(c.bladder_thickness, c.bladder_width), params, "bladder_wall",
+          "the bladder walls must leave a chamber: 2 bladder_wall < bladder_thickness and bladder_width");
+  require(2 * w < c.length - 2 * c.foot_length, params, "bladder_wall",
+          "the bladder walls must leave a chamber along the axis");
+
+  Assembly a;
+  a.length = c.length;
+  a.foot_length = c.foot_length;
+  a.volume_order = volume_order(true);
+  const double hb = c.bladder_thickness, ds = 0.5 * (t - tf);
+  const double z_core = hb + t, z_top = z_core + c.core_gap, z_upper = z_top + t;
+  a.foot_z = hb;
+  a.scale = std::max({c.width, c.length, z_upper + hb});
+  // Each skin layer: DS10 | fabric | DS10; the lowest sheet is split at the feet.
+  add_split_layer(a, c.width, hb, hb + ds, "skin");
+  a.pieces.push_back({axis_box(0, c.width, 0, c.length, hb + ds, hb + ds + tf), "fabric"});
+  a.pieces.push_back({axis_box(0, c.width, 0, c.length, hb + ds + tf, z_core), "skin"});
+  add_core(a, c.width, c.edge, c.seal, z_core, z_top);
+  a.pieces.push_back({axis_box(0, c.width, 0, c.length, z_top, z_top + ds), "skin"});
+  a.pieces.push_back({axis_box(0, c.width, 0, c.length, z_top + ds, z_top + ds + tf), "fabric"});
+  a.pieces.push_back({axis_box(0, c.width, 0, c.length, z_top + ds + tf, z_upper), "skin"});
+  // Bladders: closed DS30 chambers (floor, roof, two side walls, two end walls).
+  const double y0 = c.foot_length, y1 = c.length - c.foot_length;
+  for (int k = 1; k <= kBladders; ++k) {
+    const auto [x0, x1] = column_x(bladder_column(k), c.width, c.bladder_width);
+    const double z0 = k <= 4 ? z_upper : 0.0, z1 = z0 + hb;
+    const std::string name = bladder_name(k);
+    a.pieces.push_back({axis_box(x0, x1, y0, y1, z0, z0 + w), name});
+    a.pieces.push_back({axis_box(x0, x1, y0, y1, z1 - w, z1), name});
+    a.pieces.push_back({axis_box(x0, x0 + w, y0, y1, z0 + w, z1 - w), name});
+    a.pieces.push_back({axis_box(x1 - w, x1, y0, y1, z0 + w, z1 - w), name});
+    a.pieces.push_back({axis_box(x0 + w, x1 - w, y0, y0 + w, z0 + w, z1 - w), name});
+    a.pieces.push_back({axis_box(x0 + w, x1 - w, y1 - w, y1, z0 + w, z1 - w), name});
+    a.cavities.push_back({axis_box(x0 + w, x1 - w, y0 + w, y1 - w, z0 + w, z1 - w), name + "_wall"});
+  }
+  return mesh_assembly(a, c.mesh_size, c.order,
+                       params.context().empty() ? "geometry robot_physical" : params.context());
+}
+
+}  // namespace morphfem

@@ -1,0 +1,50 @@
+// Parametric meshes of the shape-changing pneumatic soft robot (ROBOT.md), flat
+// configuration, built with the gmsh OpenCASCADE kernel from axis-aligned boxes joined
+// by boolean fragments (conforming: bladders and skin share their interface nodes).
+// Registered in geometry_registry() as `robot_voxel` and `robot_physical`.
+//
+// Frame (both builders): x across the body, y along it (the rolling / tube axis),
+// z up; the body occupies [0, width] x [0, length] x [0, height], so z = 0 is the
+// lowest plane (the bottom faces of the lower bladders, i.e. flat ground).
+// Stacking in z: lower bladders, bottom skin layer, core gap (sealed by solid bonded
+// strips along the long edges x ~ 0 and x ~ width and end seals at y ~ 0 and
+// y ~ length), top skin layer, upper bladders. Bladders 1..4 are on top with
+// increasing x, 5..8 below with decreasing x, so 1..8 runs around the cross-section.
+// The feet are the bottom faces of the bottom skin layer at y in [0, foot_length]
+// (foot_a) and [length - foot_length, length] (foot_b).
+//
+// Common parameters: mesh_size [m] (required), order (1 or 2, default 1).
+//
+// robot_voxel (the voxel study's model; defaults in m):
+//   width 0.15, length 0.22, layer_thickness 0.01, core_gap 0.002,
+//   edge_width 0.01 (bonded long-edge strips), end_seal 0.01 (strips closing the gap at
+//   the two ends), bladder_thickness 0.02, bladder_width 0.03 (four columns per face,
+//   evenly spaced from x = 0 to x = width), bladder_start 0.03, bladder_end 0.19 (y),
+//   foot_length 0.03.
+//   Volumes: skin (both layers and the bonding strips), bladder_1 .. bladder_8 (solid).
+//   Surfaces: core_wall (closed inner boundary of the core gap), bottom (every
+//   downward-facing outer face: lower-bladder bottoms at z = 0 and uncovered skin
+//   bottom, feet included), foot_a, foot_b (also in bottom), outer (the rest of the
+//   outer boundary). core_wall, bottom and outer together hold every boundary face once.
+//
+// robot_physical (the physical laminate; defaults in m):
+//   width 0.10 (flat width = half of the 0.20 circumference), length 0.15 (tube axis),
+//   skin_thickness 0.003 per layer, fabric_thickness 0.0005 (fabric sheet at the
+//   mid-thickness of each skin layer), core_gap 0.001, edge_width 0.005, end_seal 0.005,
+//   bladder_thickness 0.003, bladder_wall 0.0008 (DS30 wall around each chamber),
+//   bladder_width 0.02, foot_length 0.02 (bladders span y in [foot_length,
+//   length - foot_length]).
+//   Volumes: skin (DS10: both layers without the fabric, the bonding strips), fabric,
+//   bladder_1 .. bladder_8 (DS30 chamber walls).
+//   Surfaces: core_wall, bladder_1_wall .. bladder_8_wall (closed chamber cavities),
+//   bottom, foot_a, foot_b, outer (as for robot_voxel).
+#pragma once
+#include "core/params.h"
+#include "mesh/mesh.h"
+
+namespace morphfem {
+
+Mesh build_robot_voxel(const ParamSet& params);
+Mesh build_robot_physical(const ParamSet& params);
+
+}  // namespace morphfem
