@@ -212,7 +212,7 @@ Scene read_scene(const std::string& path) {
   }
 
   if (const auto l = root["loads"]) {
-    r.allow(l, "loads", {"gravity", "cavities", "tractions"});
+    r.allow(l, "loads", {"gravity", "cavities", "gas_cavities", "tractions"});
     if (l["gravity"]) scene.gravity = r.vector3(l["gravity"], "loads.gravity");
     if (const auto cs = l["cavities"]) {
       if (!cs.IsSequence()) r.fail(cs, "loads.cavities", "expected a list");
@@ -226,6 +226,36 @@ Scene read_scene(const std::string& path) {
         if (c["volume_axes"]) spec.axes = r.axes(c["volume_axes"], "loads.cavities.volume_axes");
         spec.pressure = r.ramp_or_table(c["pressure"], "loads.cavities.pressure", end);
         scene.cavities.push_back(spec);
+      }
+    }
+    if (const auto gs = l["gas_cavities"]) {
+      if (!gs.IsSequence()) r.fail(gs, "loads.gas_cavities", "expected a list");
+      for (const auto& c : gs) {
+        const std::string key = "loads.gas_cavities";
+        r.allow(c, key, {"name", "surfaces", "volume_axes", "symmetry_factor", "temperature", "initial_gauge_pressure",
+                         "supply_pressure", "conductance"});
+        GasCavitySpec spec;
+        if (!c["surfaces"]) r.fail(c, key, "missing key 'surfaces'");
+        spec.wall.name = c["name"] ? r.text(c["name"], key + ".name") : "gas" + std::to_string(scene.gas_cavities.size());
+        spec.wall.surfaces = r.texts(c["surfaces"], key + ".surfaces");
+        if (c["volume_axes"]) spec.wall.axes = r.axes(c["volume_axes"], key + ".volume_axes");
+        auto positive = [&](const char* k, double& out) {
+          if (!c[k]) return;
+          out = r.number(c[k], key + "." + k);
+          if (!(out > 0)) r.fail(c[k], key + "." + k, "must be positive");
+        };
+        positive("symmetry_factor", spec.wall.symmetry_factor);
+        positive("temperature", spec.temperature);
+        if (c["initial_gauge_pressure"]) spec.initial_gauge_pressure = r.number(c["initial_gauge_pressure"], key + ".initial_gauge_pressure");
+        auto constant_or_table = [&](const char* k, TimeFunction& out) {
+          if (!c[k]) return;
+          out = c[k].IsScalar() ? TimeFunction::constant(r.number(c[k], key + "." + k)) : r.ramp_or_table(c[k], key + "." + k, end);
+        };
+        constant_or_table("supply_pressure", spec.supply_gauge_pressure);
+        constant_or_table("conductance", spec.conductance);
+        for (const auto& [t, v] : spec.conductance.points())
+          if (v < 0) r.fail(c["conductance"], key + ".conductance", "must not be negative");
+        scene.gas_cavities.push_back(spec);
       }
     }
     if (const auto ts = l["tractions"]) {

@@ -17,6 +17,11 @@
 //       - {name: core, surfaces: [inner], volume_axes: [x, y], pressure: 40e3}
 //         # pressure [Pa]: a number (ramped 0 -> value over the run) or a table
 //         # [[t0, p0], [t1, p1], ...] (piecewise linear, times in s)
+//     gas_cavities:                             # isothermal ideal gas fed through a valve
+//       - {name: core, surfaces: [inner], volume_axes: [x, y, z], symmetry_factor: 1,
+//          temperature: 293.15, initial_gauge_pressure: 0,          # K, Pa
+//          supply_pressure: 50e3, conductance: 1e-8}                # Pa (gauge), mol/(s Pa)
+//         # supply_pressure / conductance: a number (constant) or a table [[t, v], ...]
 //     tractions:
 //       - {surface: tip, traction: [0, 0, -100]}  # dead load [Pa], ramped like pressure
 //   solver: {end_time: 1, initial_step: 0.1, min_step: 1e-6, max_step: 1,
@@ -40,6 +45,7 @@
 #include <vector>
 
 #include "actuation/cavity.h"
+#include "actuation/gas_cavity.h"
 #include "contact/friction.h"
 #include "contact/ground.h"
 #include "fem/inertia.h"
@@ -73,6 +79,7 @@ struct Scene {
   std::vector<BoundarySpec> boundary;
   Eigen::Vector3d gravity = Eigen::Vector3d::Zero();
   std::vector<CavitySpec> cavities;
+  std::vector<GasCavitySpec> gas_cavities;
   std::vector<TractionSpec> tractions;
   // Code-built scenes only: a body force b(X, t) [N/m^3] on every cell (e.g. a
   // manufactured solution's load), integrated with `body_force_degree`.

@@ -116,6 +116,8 @@ Mesh build_scene_mesh(const Scene& scene, MPI_Comm comm) {
   for (const auto& c : scene.cavities)
     for (const auto& s : c.surfaces) require_surface(scene, mesh, s, "", "loads.cavities." + c.name);
   for (const auto& t : scene.tractions) require_surface(scene, mesh, t.surface, t.where, "loads.tractions");
+  for (const auto& c : scene.gas_cavities)
+    for (const auto& s : c.wall.surfaces) require_surface(scene, mesh, s, "", "loads.gas_cavities." + c.wall.name);
   if (scene.ground_contact)
     for (const auto& surface : scene.ground.surfaces) require_surface(scene, mesh, surface, "", "contact.ground.surfaces");
   if (scene.friction)
@@ -172,6 +174,11 @@ SimulationResult run_scene(const Scene& scene, MPI_Comm comm, const RunOptions& 
   for (const auto& spec : scene.cavities) {
     cavities.push_back(std::make_shared<CavityPressureTerm>(mesh, partition, rank, spec));
     assembler.add_term(cavities.back());
+  }
+  std::vector<std::shared_ptr<GasCavityTerm>> gas_cavities;
+  for (const auto& spec : scene.gas_cavities) {
+    gas_cavities.push_back(std::make_shared<GasCavityTerm>(mesh, partition, rank, spec));
+    assembler.add_term(gas_cavities.back());
   }
   for (const auto& t : scene.tractions) {
     const Eigen::Vector3d traction = t.traction;
@@ -232,6 +239,7 @@ SimulationResult run_scene(const Scene& scene, MPI_Comm comm, const RunOptions& 
   }
   result.dofs = assembler.n_dofs();
   for (const auto& c : cavities) result.cavity_names.push_back(c->spec().name);
+  for (const auto& c : gas_cavities) result.cavity_names.push_back(c->spec().wall.name);
 
   // ---- Output (rank 0 writes; every rank takes part in the gathers).
   const bool write = options.write_output && !scene.output_dir.empty();
@@ -245,6 +253,11 @@ SimulationResult run_scene(const Scene& scene, MPI_Comm comm, const RunOptions& 
   for (const auto& c : cavities) {
     cavity_columns.push_back(c->spec().name + "_pressure_Pa");
     cavity_columns.push_back(c->spec().name + "_volume_m3");
+  }
+  for (const auto& c : gas_cavities) {
+    cavity_columns.push_back(c->spec().wall.name + "_pressure_Pa");
+    cavity_columns.push_back(c->spec().wall.name + "_volume_m3");
+    cavity_columns.push_back(c->spec().wall.name + "_amount_mol");
   }
   std::vector<std::string> energy_columns{"time"};
   for (const auto& term : assembler.terms()) energy_columns.push_back(term->name() + "_J");
@@ -260,6 +273,10 @@ SimulationResult run_scene(const Scene& scene, MPI_Comm comm, const RunOptions& 
     for (const auto& c : cavities) {
       result.cavity_pressure.push_back(c->pressure());
       result.cavity_volume.push_back(c->volume(assembler, solver.solution()));
+    }
+    for (const auto& c : gas_cavities) {
+      result.cavity_pressure.push_back(c->pressure());
+      result.cavity_volume.push_back(c->cavity_volume());
     }
     // Cell measures: each rank fills its own cells, a reduction gathers them.
     std::vector<double> J(mesh.n_cells(), 0.0), vm(mesh.n_cells(), 0.0), Jg(mesh.n_cells()), vmg(mesh.n_cells());
@@ -316,7 +333,12 @@ SimulationResult run_scene(const Scene& scene, MPI_Comm comm, const RunOptions& 
         row.push_back(result.cavity_pressure[i]);
         row.push_back(result.cavity_volume[i]);
       }
-      if (!cavities.empty()) writer->append_row("cavities", cavity_columns, row);
+      for (size_t i = 0; i < gas_cavities.size(); ++i) {
+        row.push_back(result.cavity_pressure[cavities.size() + i]);
+        row.push_back(result.cavity_volume[cavities.size() + i]);
+        row.push_back(gas_cavities[i]->amount());
+      }
+      if (cavity_columns.size() > 1) writer->append_row("cavities", cavity_columns, row);
       std::vector<double> erow{t};
       erow.insert(erow.end(), energies.begin(), energies.end());
       writer->append_row("energy", energy_columns, erow);
@@ -358,7 +380,7 @@ SimulationResult run_scene(const Scene& scene, MPI_Comm comm, const RunOptions& 
           .add("min_J", result.min_J)
           .add("max_displacement_m", result.u.rowwise().norm().maxCoeff());
       std::vector<Json> cavs;
-      for (size_t i = 0; i < cavities.size(); ++i) {
+      for (size_t i = 0; i < result.cavity_names.size(); ++i) {
         Json c;
         c.add("name", result.cavity_names[i]).add("pressure_Pa", result.cavity_pressure[i]).add("volume_m3", result.cavity_volume[i]);
         cavs.push_back(c);

@@ -77,8 +77,7 @@ struct SurfaceSample {
 
 Vec3 node_coordinates(std::size_t tag) {
   std::vector<double> coord, parametric;
-  int dim = 0, entity = 0;
-  gmsh::model::mesh::getNode(tag, coord, parametric, dim, entity);
+  gmsh::model::mesh::getNode(tag, coord, parametric);
   return Vec3(coord[0], coord[1], coord[2]);
 }
 

@@ -142,3 +142,31 @@ TEST(Scene, GamgWithRigidBodyNearNullspaceMatchesMumps) {
   ASSERT_TRUE(a.stats.completed && b.stats.completed);
   EXPECT_LT((a.u - b.u).cwiseAbs().maxCoeff(), 1e-7 * a.u.cwiseAbs().maxCoeff());
 }
+
+// Every example scene parses and runs to completion (without writing results).
+TEST(Scene, EveryExampleSceneRuns) {
+  int count = 0;
+  for (const auto& entry : fs::directory_iterator(fs::path(MORPHFEM_SOURCE_DIR) / "examples")) {
+    if (entry.path().extension() != ".yaml") continue;
+    Scene scene = read_scene(entry.path().string());
+    auto r = run_scene(scene, PETSC_COMM_WORLD, {false, false, {}});
+    EXPECT_TRUE(r.stats.completed) << entry.path() << ": " << r.stats.failure;
+    EXPECT_GT(r.min_J, 0.0) << entry.path();
+    ++count;
+  }
+  EXPECT_GE(count, 3);
+}
+
+TEST(Scene, GasCavityFillsTowardsTheSupplyPressure) {
+  Scene scene = read_scene(std::string(MORPHFEM_SOURCE_DIR) + "/examples/balloon_valve.yaml");
+  std::vector<double> pressure;
+  RunOptions options{false, false, {}};
+  options.on_step = [&](double, const Mesh&, const RowMatrixXd&, const SimulationResult& r) {
+    pressure.push_back(r.cavity_pressure.at(0));
+  };
+  auto r = run_scene(scene, PETSC_COMM_WORLD, options);
+  ASSERT_TRUE(r.stats.completed);
+  for (size_t i = 1; i < pressure.size(); ++i) EXPECT_GE(pressure[i], pressure[i - 1] - 1e-9);
+  EXPECT_GT(pressure.back(), 1000.0);
+  EXPECT_LT(pressure.back(), 5000.0);  // below the 5 kPa supply
+}

@@ -1,0 +1,276 @@
+// Robot geometries: named regions, analytic region volumes, closed cavity walls that
+// enclose the cavity volumes, feet in the skin's bottom plane, bladder numbering.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/errors.h"
+#include "mesh/geometry.h"
+#include "mesh/robot.h"
+
+namespace morphfem {
+namespace {
+
+using Vec3 = Eigen::Vector3d;
+
+ParamSet robot_params(const std::string& type, const std::vector<std::pair<std::string, double>>& values) {
+  ParamSet params("geometry");
+  params.set_string("type", type);
+  for (const auto& [key, value] : values) params.set(key, value);
+  return params;
+}
+
+Vec3 node(const Mesh& mesh, int n) { return mesh.X.row(n).transpose(); }
+
+Vec3 face_area_normal(const Mesh& mesh, int f) {
+  const Vec3 x0 = node(mesh, mesh.faces(f, 0));
+  return 0.5 * (node(mesh, mesh.faces(f, 1)) - x0).cross(node(mesh, mesh.faces(f, 2)) - x0);
+}
+
+double cell_volume(const Mesh& mesh, int c) {
+  const Vec3 x0 = node(mesh, mesh.cells(c, 0));
+  return (node(mesh, mesh.cells(c, 1)) - x0)
+             .dot((node(mesh, mesh.cells(c, 2)) - x0).cross(node(mesh, mesh.cells(c, 3)) - x0)) /
+         6.0;
+}
+
+double region_volume(const Mesh& mesh, const std::string& name) {
+  double v = 0.0;
+  for (int c : mesh.cells_of(name)) v += cell_volume(mesh, c);
+  return v;
+}
+
+Vec3 region_centroid(const Mesh& mesh, const std::string& name) {
+  Vec3 sum = Vec3::Zero();
+  double v = 0.0;
+  for (int c : mesh.cells_of(name)) {
+    const double vc = cell_volume(mesh, c);
+    Vec3 x = Vec3::Zero();
+    for (int k = 0; k < 4; ++k) x += node(mesh, mesh.cells(c, k)) / 4.0;
+    sum += vc * x;
+    v += vc;
+  }
+  return sum / v;
+}
+
+// Faces of the surfaces point out of the solid; returns -(1/3) sum x.n A (the volume
+// they enclose if they close a cavity) and the residual |sum n A| (0 when closed).
+std::pair<double, double> enclosed_volume(const Mesh& mesh, const std::vector<std::string>& surfaces) {
+  double v = 0.0;
+  Vec3 sum = Vec3::Zero();
+  for (const std::string& s : surfaces)
+    for (int f : mesh.faces_of(s)) {
+      const Vec3 na = face_area_normal(mesh, f);
+      v -= node(mesh, mesh.faces(f, 0)).dot(na) / 3.0;
+      sum += na;
+    }
+  return {v, sum.norm()};
+}
+
+double area(const Mesh& mesh, const std::string& surface) {
+  double a = 0.0;
+  for (int f : mesh.faces_of(surface)) a += face_area_normal(mesh, f).norm();
+  return a;
+}
+
+// Every face of `surface` lies in z = z0 within y in [y0, y1] and faces down.
+void expect_downward_in_plane(const Mesh& mesh, const std::string& surface, double z0, double y0, double y1) {
+  ASSERT_FALSE(mesh.faces_of(surface).empty()) << surface;
+  for (int f : mesh.faces_of(surface)) {
+    for (int k = 0; k < mesh.nodes_per_face(); ++k) {
+      const Vec3 x = node(mesh, mesh.faces(f, k));
+      EXPECT_NEAR(x.z(), z0, 1e-12) << surface << " face " << f;
+      EXPECT_GE(x.y(), y0 - 1e-12) << surface << " face " << f;
+      EXPECT_LE(x.y(), y1 + 1e-12) << surface << " face " << f;
+    }
+    EXPECT_LT(face_area_normal(mesh, f).normalized().z(), -1.0 + 1e-12) << surface << " face " << f;
+  }
+}
+
+std::vector<std::string> sorted(std::vector<std::string> v) {
+  std::sort(v.begin(), v.end());
+  return v;
+}
+
+std::vector<std::string> bladder_names(const std::string& suffix) {
+  std::vector<std::string> names;
+  for (int k = 1; k <= 8; ++k) names.push_back("bladder_" + std::to_string(k) + suffix);
+  return names;
+}
+
+// Voxel-study preset, default dimensions [m].
+constexpr double kW = 0.15, kL = 0.22, kT = 0.01, kGap = 0.002, kEdge = 0.01, kSeal = 0.01, kHb = 0.02;
+constexpr double kBw = 0.03, kBy0 = 0.03, kBy1 = 0.19, kFoot = 0.03;
+
+// "bottom": the lower bladders' bottoms at z = 0 and the uncovered skin bottom at
+// z = kHb, all facing down.
+void expect_bottom_levels(const Mesh& mesh) {
+  double at_ground = 0.0, at_skin = 0.0;
+  for (int f : mesh.faces_of("bottom")) {
+    const double z = node(mesh, mesh.faces(f, 0)).z(), a = face_area_normal(mesh, f).norm();
+    if (std::abs(z) < 1e-12) at_ground += a;
+    if (std::abs(z - kHb) < 1e-12) at_skin += a;
+    EXPECT_LT(face_area_normal(mesh, f).normalized().z(), -1.0 + 1e-12);
+  }
+  EXPECT_NEAR(at_ground, 4 * kBw * (kBy1 - kBy0), 1e-12);
+  EXPECT_NEAR(at_skin, kW * kL - 4 * kBw * (kBy1 - kBy0), 1e-12);
+}
+
+void expect_voxel_robot(const Mesh& mesh) {
+  std::vector<std::string> volumes = bladder_names("");
+  volumes.push_back("skin");
+  EXPECT_EQ(sorted(mesh.region_names(3)), sorted(volumes));
+  EXPECT_EQ(sorted(mesh.region_names(2)), sorted({"core_wall", "bottom", "foot_a", "foot_b", "outer"}));
+
+  // Region volumes: exact for straight-sided tetrahedra filling boxes.
+  const double skin = 2 * kW * kL * kT + 2 * kEdge * kL * kGap + 2 * (kW - 2 * kEdge) * kSeal * kGap;
+  const double bladder = kBw * (kBy1 - kBy0) * kHb;
+  EXPECT_NEAR(region_volume(mesh, "skin"), skin, 1e-10 * skin);
+  for (int k = 1; k <= 8; ++k)
+    EXPECT_NEAR(region_volume(mesh, "bladder_" + std::to_string(k)), bladder, 1e-10 * bladder) << k;
+  EXPECT_NEAR(mesh.volume(), skin + 8 * bladder, 1e-10 * skin);
+
+  // The core wall is closed and encloses the gap.
+  const double gap = (kW - 2 * kEdge) * (kL - 2 * kSeal) * kGap;
+  const auto [core_volume, core_residual] = enclosed_volume(mesh, {"core_wall"});
+  EXPECT_GT(core_volume, 0.0);
+  EXPECT_NEAR(core_volume, gap, 1e-10 * gap);
+  EXPECT_LT(core_residual, 1e-14);
+  // core_wall + bottom + outer is the whole boundary, once: encloses minus the solid.
+  const auto [all_volume, all_residual] = enclosed_volume(mesh, {"core_wall", "bottom", "outer"});
+  EXPECT_NEAR(all_volume, -(skin + 8 * bladder), 1e-10 * skin);
+  EXPECT_LT(all_residual, 1e-14);
+
+  // Feet in the skin's bottom plane; bottom = lower bladders' bottoms + uncovered skin
+  // bottom, which together cover the footprint once.
+  expect_downward_in_plane(mesh, "foot_a", kHb, 0.0, kFoot);
+  expect_downward_in_plane(mesh, "foot_b", kHb, kL - kFoot, kL);
+  EXPECT_NEAR(area(mesh, "foot_a"), kW * kFoot, 1e-12);
+  EXPECT_NEAR(area(mesh, "foot_b"), kW * kFoot, 1e-12);
+  EXPECT_NEAR(area(mesh, "bottom"), kW * kL, 1e-12);
+  expect_bottom_levels(mesh);
+}
+
+// Bladders 1..4 on top with increasing x, 5..8 below with decreasing x.
+void expect_bladder_numbering(const Mesh& mesh, double pitch, double top_z_min) {
+  for (int k = 1; k <= 8; ++k) {
+    const Vec3 c = region_centroid(mesh, "bladder_" + std::to_string(k));
+    const int column = k <= 4 ? k - 1 : 8 - k;
+    EXPECT_NEAR(c.x(), kBw / 2 + column * pitch, 1e-9) << k;
+    if (k <= 4) {
+      EXPECT_GT(c.z(), top_z_min) << k;
+    } else {
+      EXPECT_LT(c.z(), kHb) << k;
+    }
+  }
+}
+
+}  // namespace
+
+TEST(RobotGeometry, VoxelPresetP1) {
+  const Mesh mesh = build_geometry(robot_params("robot_voxel", {{"mesh_size", 0.015}}));
+  EXPECT_EQ(mesh.order, 1);
+  expect_voxel_robot(mesh);
+  expect_bladder_numbering(mesh, 0.04, kHb + 2 * kT + kGap);
+}
+
+TEST(RobotGeometry, VoxelPresetP2) {
+  const Mesh mesh = build_geometry(robot_params("robot_voxel", {{"mesh_size", 0.03}, {"order", 2}}));
+  EXPECT_EQ(mesh.order, 2);
+  EXPECT_EQ(mesh.nodes_per_cell(), 10);
+  expect_voxel_robot(mesh);
+}
+
+TEST(RobotGeometry, PhysicalPreset) {
+  // Defaults of robot_physical [m].
+  const double W = 0.10, L = 0.15, t = 0.003, tf = 0.0005, g = 0.001, e = 0.005, s = 0.005, hb = 0.003, w = 0.0008;
+  const double bw = 0.02, foot = 0.02;
+  const Mesh mesh = build_geometry(robot_params("robot_physical", {{"mesh_size", 0.006}}));
+
+  std::vector<std::string> volumes = bladder_names("");
+  volumes.push_back("skin");
+  volumes.push_back("fabric");
+  EXPECT_EQ(sorted(mesh.region_names(3)), sorted(volumes));
+  std::vector<std::string> surfaces = bladder_names("_wall");
+  for (const char* name : {"core_wall", "bottom", "foot_a", "foot_b", "outer"}) surfaces.push_back(name);
+  EXPECT_EQ(sorted(mesh.region_names(2)), sorted(surfaces));
+
+  const double fabric = 2 * W * L * tf;
+  const double skin = 2 * W * L * (t - tf) + 2 * e * L * g + 2 * (W - 2 * e) * s * g;
+  const double chamber = (bw - 2 * w) * (L - 2 * foot - 2 * w) * (hb - 2 * w);
+  const double bladder = bw * (L - 2 * foot) * hb - chamber;
+  EXPECT_NEAR(region_volume(mesh, "fabric"), fabric, 1e-10 * fabric);
+  EXPECT_NEAR(region_volume(mesh, "skin"), skin, 1e-10 * skin);
+  for (int k = 1; k <= 8; ++k) {
+    const std::string name = "bladder_" + std::to_string(k);
+    EXPECT_NEAR(region_volume(mesh, name), bladder, 1e-10 * bladder) << k;
+    const auto [v, residual] = enclosed_volume(mesh, {name + "_wall"});
+    EXPECT_NEAR(v, chamber, 1e-10 * chamber) << k;
+    EXPECT_LT(residual, 1e-14) << k;
+  }
+  const double gap = (W - 2 * e) * (L - 2 * s) * g;
+  const auto [core, core_residual] = enclosed_volume(mesh, {"core_wall"});
+  EXPECT_NEAR(core, gap, 1e-10 * gap);
+  EXPECT_LT(core_residual, 1e-14);
+
+  std::vector<std::string> boundary = bladder_names("_wall");
+  for (const char* name : {"core_wall", "bottom", "outer"}) boundary.push_back(name);
+  const auto [all, all_residual] = enclosed_volume(mesh, boundary);
+  EXPECT_NEAR(all, -(skin + fabric + 8 * bladder), 1e-10 * skin);
+  EXPECT_LT(all_residual, 1e-14);
+
+  expect_downward_in_plane(mesh, "foot_a", hb, 0.0, foot);
+  expect_downward_in_plane(mesh, "foot_b", hb, L - foot, L);
+  EXPECT_NEAR(area(mesh, "foot_a"), W * foot, 1e-12);
+  EXPECT_NEAR(area(mesh, "bottom"), W * L, 1e-12);
+
+  // Fabric sheets at mid-thickness of both skin layers; bladders 1..4 on top, 5..8 below.
+  double z_min = 1.0, z_max = 0.0;
+  for (int c : mesh.cells_of("fabric"))
+    for (int k = 0; k < 4; ++k) {
+      z_min = std::min(z_min, node(mesh, mesh.cells(c, k)).z());
+      z_max = std::max(z_max, node(mesh, mesh.cells(c, k)).z());
+    }
+  EXPECT_NEAR(z_min, hb + (t - tf) / 2, 1e-12);
+  EXPECT_NEAR(z_max, hb + t + g + (t + tf) / 2, 1e-12);
+  const double pitch = (W - bw) / 3;
+  for (int k = 1; k <= 8; ++k) {
+    const Vec3 c = region_centroid(mesh, "bladder_" + std::to_string(k));
+    EXPECT_NEAR(c.x(), bw / 2 + (k <= 4 ? k - 1 : 8 - k) * pitch, 1e-9) << k;
+    EXPECT_NEAR(c.z(), k <= 4 ? hb + 2 * t + g + hb / 2 : hb / 2, 1e-9) << k;
+  }
+}
+
+TEST(RobotGeometry, OverridesAndBadParameters) {
+  // A thinner gap and narrower bonded edges change the core volume accordingly.
+  const Mesh mesh = build_geometry(
+      robot_params("robot_voxel", {{"mesh_size", 0.03}, {"core_gap", 0.001}, {"edge_width", 0.02}}));
+  const auto [core, residual] = enclosed_volume(mesh, {"core_wall"});
+  EXPECT_NEAR(core, (kW - 0.04) * (kL - 2 * kSeal) * 0.001, 1e-10 * core);
+
+  EXPECT_THROW(build_geometry(robot_params("robot_voxel", {{"mesh_size", 0.03}, {"edge_width", 0.08}})), InputError);
+  EXPECT_THROW(build_geometry(robot_params("robot_voxel", {{"mesh_size", 0.03}, {"bladder_width", 0.04}})),
+               InputError);
+  EXPECT_THROW(build_geometry(robot_params("robot_voxel", {{"mesh_size", 0.03}, {"core_gapp", 0.001}})), InputError);
+  EXPECT_THROW(build_geometry(robot_params("robot_voxel", {{"mesh_size", 0.03}, {"core_gap", 0.0}})), InputError);
+  EXPECT_THROW(build_geometry(robot_params("robot_physical", {{"mesh_size", 0.03}, {"bladder_wall", 0.002}})),
+               InputError);
+  EXPECT_THROW(build_geometry(robot_params("robot_physical", {{"mesh_size", 0.03}, {"fabric_thickness", 0.003}})),
+               InputError);
+}
+
+TEST(RobotGeometry, PhysicalPresetP2) {
+  const Mesh mesh = build_geometry(robot_params("robot_physical", {{"mesh_size", 0.03}, {"order", 2}}));
+  EXPECT_EQ(mesh.order, 2);
+  const double chamber = (0.02 - 0.0016) * (0.15 - 0.04 - 0.0016) * (0.003 - 0.0016);
+  for (int k = 1; k <= 8; ++k) {
+    const auto [v, residual] = enclosed_volume(mesh, {"bladder_" + std::to_string(k) + "_wall"});
+    EXPECT_NEAR(v, chamber, 1e-10 * chamber) << k;
+  }
+  EXPECT_NEAR(mesh.volume(), region_volume(mesh, "skin") + region_volume(mesh, "fabric") +
+                                 8 * region_volume(mesh, "bladder_1"), 1e-9 * mesh.volume());
+  expect_downward_in_plane(mesh, "foot_b", 0.003, 0.13, 0.15);
+}
+
+}  // namespace morphfem
