@@ -40,8 +40,7 @@ double cavity_face_integral(const ShapeTable& table, const std::array<bool, 3>& 
       for (int c = 0; c < n; ++c)
         for (int d = 0; d < n; ++d) {
           // d/dx_d of the gradient block c (see the header's formula derivation).
-          Eigen::Matrix3d block = N[c] * (-Nxi[d] * SCb + Neta[d] * SCa) +
-                                  Nxi[c] * (-Neta[d] * Cv + N[d] * CbS) +
+          Eigen::Matrix3d block = N[c] * (-Nxi[d] * SCb + Neta[d] * SCa) + Nxi[c] * (-Neta[d] * Cv + N[d] * CbS) +
                                   Neta[c] * (-N[d] * CaS + Nxi[d] * Cv);
           H->block<3, 3>(3 * c, 3 * d) += w * block;
         }

@@ -24,16 +24,16 @@ namespace morphfem {
 
 struct CavitySpec {
   std::string name;
-  std::vector<std::string> surfaces;       // wall surface regions
+  std::vector<std::string> surfaces;           // wall surface regions
   std::array<bool, 3> axes{true, true, true};  // S: which coordinates enter V
-  TimeFunction pressure;                  // p(t) [Pa], gauge
+  TimeFunction pressure;                       // p(t) [Pa], gauge
 };
 
 // Kernel for one wall face (n nodes): f = int (S x).(a x b) dxi deta with
 // a = dx/dxi, b = dx/deta; gradient and Hessian w.r.t. nodal positions (3n).
 // Exposed for the finite-difference tests.
-double cavity_face_integral(const ShapeTable& table, const std::array<bool, 3>& axes,
-                            const Eigen::MatrixXd& x, Eigen::VectorXd* g, Eigen::MatrixXd* H);
+double cavity_face_integral(const ShapeTable& table, const std::array<bool, 3>& axes, const Eigen::MatrixXd& x,
+                            Eigen::VectorXd* g, Eigen::MatrixXd* H);
 
 class CavityPressureTerm : public EnergyTerm {
  public:

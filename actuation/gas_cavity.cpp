@@ -233,7 +233,8 @@ double CavityVolumeTerm::max_step(Assembler& assembler, Vec u, Vec du) {
 
 GasCavityTerm::GasCavityTerm(const Mesh& mesh, const Partition& partition, int rank, GasCavitySpec spec)
     : CavityVolumeTerm(mesh, partition, rank, spec.wall), spec_(std::move(spec)) {
-  if (!(spec_.temperature > 0)) throw std::invalid_argument("gas cavity '" + wall_.name + "': temperature must be > 0 K");
+  if (!(spec_.temperature > 0))
+    throw std::invalid_argument("gas cavity '" + wall_.name + "': temperature must be > 0 K");
   if (!(spec_.atmospheric_pressure >= 0))
     throw std::invalid_argument("gas cavity '" + wall_.name + "': atmospheric_pressure must be >= 0 Pa");
   if (std::isnan(spec_.initial_amount)) {
@@ -384,8 +385,6 @@ double VolumeControlledCavityTerm::energy_of_volume(double V) const {
   return -multiplier_ * e + 0.5 * penalty_ * e * e;
 }
 
-double VolumeControlledCavityTerm::energy_derivative(double V) const {
-  return -multiplier_ + penalty_ * (V - target_);
-}
+double VolumeControlledCavityTerm::energy_derivative(double V) const { return -multiplier_ + penalty_ * (V - target_); }
 
 }  // namespace morphfem

@@ -123,8 +123,8 @@ class CavityVolumeTerm : public EnergyTerm {
 // m = n0, V_r = 0.
 struct GasCavitySpec {
   CavityWallSpec wall;
-  double temperature = 293.15;            // T [K]
-  double atmospheric_pressure = 101325.0; // p_atm [Pa], absolute outside pressure
+  double temperature = 293.15;             // T [K]
+  double atmospheric_pressure = 101325.0;  // p_atm [Pa], absolute outside pressure
   // Initial gas amount [mol]; NaN: the amount at initial_gauge_pressure [Pa] in the
   // reference (undeformed) cavity, n0 = (p_atm + p0) V_ref / (R T).
   double initial_amount = std::numeric_limits<double>::quiet_NaN();
@@ -154,9 +154,9 @@ class GasCavityTerm : public CavityVolumeTerm {
   void end_valve_step(double V1, double t1);
 
   // At the last converged state (last converged state after end_step):
-  double absolute_pressure() const;                                          // p [Pa]
+  double absolute_pressure() const;                                                     // p [Pa]
   double pressure() const { return absolute_pressure() - spec_.atmospheric_pressure; }  // gauge [Pa]
-  double amount() const { return amount_; }                                  // n [mol]
+  double amount() const { return amount_; }                                             // n [mol]
   double molar_flow_rate() const { return flow_rate_; }  // (n1 - n0)/dt of the last step [mol/s]
   // Sets the gas amount [mol] (e.g. a sealed cavity filled to a given state).
   void set_amount(double n);
@@ -166,9 +166,9 @@ class GasCavityTerm : public CavityVolumeTerm {
 
  private:
   GasCavitySpec spec_;
-  double amount_ = 0.0;      // n at the last converged state [mol]
-  double step_amount_ = 0.0; // m of the current step [mol]
-  double reservoir_ = 0.0;   // V_r of the current step [m^3]
+  double amount_ = 0.0;       // n at the last converged state [mol]
+  double step_amount_ = 0.0;  // m of the current step [mol]
+  double reservoir_ = 0.0;    // V_r of the current step [m^3]
   double step_dt_ = 0.0, flow_rate_ = 0.0;
 };
 
@@ -214,7 +214,7 @@ class VolumeControlledCavityTerm : public CavityVolumeTerm {
   double energy_second_derivative(double V) const override { return penalty_; }
 
   double pressure() const { return converged_pressure_; }  // gauge [Pa], last converged state
-  double target_volume() const { return target_; }  // V*(t) [m^3]
+  double target_volume() const { return target_; }         // V*(t) [m^3]
   double multiplier() const { return multiplier_; }
   double penalty() const { return penalty_; }
   int outer_updates() const { return outer_updates_; }  // total multiplier updates so far

@@ -17,8 +17,8 @@ namespace morphfem {
 
 namespace {
 
-const std::array<std::string, kNumChannels> kChannelNames = {
-    "b1", "b2", "b3", "b4", "b5", "b6", "b7", "b8", "core", "foot_a", "foot_b"};
+const std::array<std::string, kNumChannels> kChannelNames = {"b1", "b2", "b3",   "b4",     "b5",    "b6",
+                                                             "b7", "b8", "core", "foot_a", "foot_b"};
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
@@ -47,8 +47,7 @@ struct Reader {
     const std::string& s = n.Scalar();
     char* end = nullptr;
     double v = std::strtod(s.c_str(), &end);
-    if (s.empty() || end != s.c_str() + s.size())
-      fail(n, key, "expected a number, got '" + s + "'");
+    if (s.empty() || end != s.c_str() + s.size()) fail(n, key, "expected a number, got '" + s + "'");
     if (!std::isfinite(v)) fail(n, key, "value is not a finite number");
     return v;
   }
@@ -62,8 +61,9 @@ struct Reader {
     double v = number(n, key);
     if (v != std::floor(v)) fail(n, key, "expected an integer, got " + fmt(v));
     if (v < lo || v > hi)
-      fail(n, key, "value " + fmt(v) + " is outside the allowed range [" + std::to_string(lo) + ", " +
-                       std::to_string(hi) + "]");
+      fail(
+          n, key,
+          "value " + fmt(v) + " is outside the allowed range [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
     return static_cast<int>(v);
   }
   std::string text(const YAML::Node& n, const std::string& key) const {
@@ -88,8 +88,7 @@ std::vector<int> parse_row(const Reader& r, const YAML::Node& n, const std::stri
   if (n.IsScalar()) {
     for (char c : n.Scalar()) {
       if (c == ' ' || c == '_') continue;
-      if (c != '0' && c != '1')
-        r.fail(n, key, std::string("row must contain only 0 and 1, found '") + c + "'");
+      if (c != '0' && c != '1') r.fail(n, key, std::string("row must contain only 0 and 1, found '") + c + "'");
       row.push_back(c - '0');
     }
   } else if (n.IsSequence()) {
@@ -102,8 +101,7 @@ std::vector<int> parse_row(const Reader& r, const YAML::Node& n, const std::stri
   return row;
 }
 
-void parse_levels(const Reader& r, const YAML::Node& n, const std::string& key, ChannelLevels& lv,
-                  bool core) {
+void parse_levels(const Reader& r, const YAML::Node& n, const std::string& key, ChannelLevels& lv, bool core) {
   if (core) {
     r.allow_only(n, key, {"pressure_pa", "ramp_s"});
     if (n["pressure_pa"]) lv.inflate_pa = r.number(n["pressure_pa"], key + ".pressure_pa");
@@ -215,13 +213,13 @@ Schedule Schedule::from_genome(const Genome& g, double column_s, int repeats, in
 void Schedule::validate() const {
   std::string w = source.empty() ? "schedule" : source;
   if (matrix.size() != kNumRows)
-    throw InputError(w + ": matrix", "expected " + std::to_string(kNumRows) + " rows, got " +
-                                         std::to_string(matrix.size()));
+    throw InputError(w + ": matrix",
+                     "expected " + std::to_string(kNumRows) + " rows, got " + std::to_string(matrix.size()));
   for (std::size_t i = 0; i < matrix.size(); ++i) {
     if (matrix[i].empty() || matrix[i].size() != matrix[0].size())
-      throw InputError(w + ": matrix[" + std::to_string(i) + "]",
-                       "all rows must have the same non-zero length (row 1 has " +
-                           std::to_string(matrix[0].size()) + " columns)");
+      throw InputError(
+          w + ": matrix[" + std::to_string(i) + "]",
+          "all rows must have the same non-zero length (row 1 has " + std::to_string(matrix[0].size()) + " columns)");
     for (int v : matrix[i])
       if (v != 0 && v != 1) throw InputError(w + ": matrix[" + std::to_string(i) + "]", "entries must be 0 or 1");
   }
@@ -247,8 +245,10 @@ double Schedule::target_pa(int channel, int column, const std::array<ChannelLeve
   if (channel == kChannelCore) return l.inflate_pa;
   int row = channel_row(channel);
   bool on;
-  if (column < 0 || column >= total_columns()) on = (row >= 8);  // rest: bladders off, feet active
-  else on = active(row, column);
+  if (column < 0 || column >= total_columns())
+    on = (row >= 8);  // rest: bladders off, feet active
+  else
+    on = active(row, column);
   return on ? l.inflate_pa : l.deflate_pa;
 }
 
@@ -319,8 +319,9 @@ Schedule parse_schedule(const std::string& text, const std::string& source) {
                      "YAML syntax error: " + e.msg);
   }
   if (!root.IsMap()) throw InputError(source, "a schedule file is a YAML mapping (key: value)");
-  r.allow_only(root, "", {"morphfem_schedule", "name", "orientation_deg", "core_pressure_pa", "column_s",
-                          "repeats", "settle_s", "matrix", "genome", "pressures"});
+  r.allow_only(root, "",
+               {"morphfem_schedule", "name", "orientation_deg", "core_pressure_pa", "column_s", "repeats", "settle_s",
+                "matrix", "genome", "pressures"});
   if (!root["morphfem_schedule"])
     throw InputError(source, "missing required key 'morphfem_schedule' (format version, 1)");
   r.integer_in(root["morphfem_schedule"], "morphfem_schedule", 1, 1);
@@ -348,8 +349,9 @@ Schedule parse_schedule(const std::string& text, const std::string& source) {
       std::string key = "matrix[" + std::to_string(i) + "] (row " + std::to_string(i + 1) + ")";
       s.matrix.push_back(parse_row(r, m[i], key));
       if (s.matrix.back().size() != s.matrix[0].size())
-        r.fail(m[i], key, "has " + std::to_string(s.matrix.back().size()) + " columns but row 1 has " +
-                              std::to_string(s.matrix[0].size()));
+        r.fail(m[i], key,
+               "has " + std::to_string(s.matrix.back().size()) + " columns but row 1 has " +
+                   std::to_string(s.matrix[0].size()));
     }
   } else {
     YAML::Node g = root["genome"];
@@ -357,8 +359,7 @@ Schedule parse_schedule(const std::string& text, const std::string& source) {
     Genome gen;
     gen.orientation_deg = s.orientation_deg;
     gen.core_pressure_pa = s.core_pressure_pa;
-    if (g["orientation_deg"])
-      gen.orientation_deg = r.number_in(g["orientation_deg"], "genome.orientation_deg", 0, 90);
+    if (g["orientation_deg"]) gen.orientation_deg = r.number_in(g["orientation_deg"], "genome.orientation_deg", 0, 90);
     if (g["core_pressure_pa"])
       gen.core_pressure_pa = r.number_in(g["core_pressure_pa"], "genome.core_pressure_pa", 0, 12000);
     int columns = g["columns"] ? r.integer_in(g["columns"], "genome.columns", 1, 10000) : 8;
@@ -507,10 +508,14 @@ PressureTrace read_pressure_log(const std::string& path) {
       ncols = f.size();
       for (std::size_t j = 0; j < f.size(); ++j) {
         const std::string& h = f[j];
-        if (h == "t_s") i_t = int(j);
-        else if (h == "kind") i_kind = int(j);
-        else if (h == "column") i_col = int(j);
-        else if (h == "message") i_msg = int(j);
+        if (h == "t_s")
+          i_t = int(j);
+        else if (h == "kind")
+          i_kind = int(j);
+        else if (h == "column")
+          i_col = int(j);
+        else if (h == "message")
+          i_msg = int(j);
         else if (h.rfind("cmd_", 0) == 0 || h.rfind("meas_", 0) == 0) {
           bool cmd = h[0] == 'c';
           std::string name = h.substr(cmd ? 4 : 5);
@@ -542,7 +547,8 @@ PressureTrace read_pressure_log(const std::string& path) {
       if (j < 0 || f[j].empty()) return kNaN;
       char* end = nullptr;
       double v = std::strtod(f[j].c_str(), &end);
-      if (end != f[j].c_str() + f[j].size()) throw InputError(where, std::string("bad number in ") + what + ": '" + f[j] + "'");
+      if (end != f[j].c_str() + f[j].size())
+        throw InputError(where, std::string("bad number in ") + what + ": '" + f[j] + "'");
       return v;
     };
     double t = num(i_t, "t_s");

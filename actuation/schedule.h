@@ -88,10 +88,10 @@ ScheduleMatrix genome_matrix(const Genome& genome, int columns = 8);
 
 // Pressure levels of one channel.
 struct ChannelLevels {
-  double inflate_pa = 0;       // "1" in the matrix (core: the held pressure)
-  double deflate_pa = 0;       // "0" in the matrix (core: unused, always 0 before start)
-  double inflate_ramp_s = 0;   // time to rise across the full swing (0 = step)
-  double deflate_ramp_s = 0;   // time to fall across the full swing (0 = step)
+  double inflate_pa = 0;      // "1" in the matrix (core: the held pressure)
+  double deflate_pa = 0;      // "0" in the matrix (core: unused, always 0 before start)
+  double inflate_ramp_s = 0;  // time to rise across the full swing (0 = step)
+  double deflate_ramp_s = 0;  // time to fall across the full swing (0 = step)
   // Rates in Pa/s (infinite for a step or a zero swing).
   double rise_rate() const;
   double fall_rate() const;
@@ -118,16 +118,15 @@ class Schedule {
   double column_s = 1.237;
   int repeats = 1;
   double settle_s = 0;
-  ScheduleMatrix matrix;          // 10 x T
-  std::optional<Genome> genome;   // set when the file gave a genome
+  ScheduleMatrix matrix;         // 10 x T
+  std::optional<Genome> genome;  // set when the file gave a genome
   std::array<ChannelLevels, kNumChannels> levels = default_levels(0);
 
   static std::array<ChannelLevels, kNumChannels> default_levels(double core_pressure_pa);
   // A schedule with default levels for the matrix (validated: 10 rows, equal length, 0/1).
-  static Schedule from_matrix(ScheduleMatrix m, double column_s = 1.237, int repeats = 1,
-                              double orientation_deg = 0, double core_pressure_pa = 0);
-  static Schedule from_genome(const Genome& g, double column_s = 1.237, int repeats = 1,
-                              int columns = 8);
+  static Schedule from_matrix(ScheduleMatrix m, double column_s = 1.237, int repeats = 1, double orientation_deg = 0,
+                              double core_pressure_pa = 0);
+  static Schedule from_genome(const Genome& g, double column_s = 1.237, int repeats = 1, int columns = 8);
 
   int columns() const { return matrix.empty() ? 0 : static_cast<int>(matrix[0].size()); }
   int total_columns() const { return columns() * repeats; }
@@ -159,9 +158,9 @@ Schedule parse_schedule(const std::string& text, const std::string& source);
 // ---------------------------------------------------------------------------
 struct PressureTrace {
   std::string source;
-  std::vector<int> channels;                 // channel indices present in the log
-  std::vector<double> t;                     // sample times (gait time, s)
-  std::vector<int> column;                   // column of each sample (-1 = rest)
+  std::vector<int> channels;                   // channel indices present in the log
+  std::vector<double> t;                       // sample times (gait time, s)
+  std::vector<int> column;                     // column of each sample (-1 = rest)
   std::vector<std::vector<double>> commanded;  // [k][i] for channels[k]; NaN if missing
   std::vector<std::vector<double>> measured;
   struct Event {
@@ -179,8 +178,7 @@ struct PressureTrace {
   // Binary matrix recovered from the commanded pressures: a row is 1 in a column
   // when the commanded pressure at the column's midpoint is nearer to inflate_pa
   // than to deflate_pa of `levels`. Columns of length column_s from t = 0.
-  ScheduleMatrix to_matrix(double column_s, int columns,
-                           const std::array<ChannelLevels, kNumChannels>& levels) const;
+  ScheduleMatrix to_matrix(double column_s, int columns, const std::array<ChannelLevels, kNumChannels>& levels) const;
 };
 
 PressureTrace read_pressure_log(const std::string& path);

@@ -51,8 +51,8 @@ int cmd_run(const std::vector<std::string>& args) {
   morphfem::Scene scene = morphfem::read_scene(path);
   auto result = morphfem::run_scene(scene, PETSC_COMM_WORLD);
   if (rank_of_world() == 0) {
-    std::printf("%s: %s, %ld dofs, %d steps, %d Newton iterations, %d step cuts, %.2f s",
-                scene.name.c_str(), result.stats.completed ? "completed" : "FAILED", result.dofs, result.stats.steps,
+    std::printf("%s: %s, %ld dofs, %d steps, %d Newton iterations, %d step cuts, %.2f s", scene.name.c_str(),
+                result.stats.completed ? "completed" : "FAILED", result.dofs, result.stats.steps,
                 result.stats.newton_its, result.stats.step_cuts, result.stats.wall_s);
     for (size_t i = 0; i < result.cavity_names.size(); ++i)
       std::printf(", cavity %s: p = %.4g Pa, V = %.4g m^3", result.cavity_names[i].c_str(), result.cavity_pressure[i],
@@ -67,8 +67,8 @@ int cmd_run(const std::vector<std::string>& args) {
 }
 
 void print_table(const std::vector<morphfem::VerificationRecord>& records) {
-  std::printf("%-11s %-48s %3s %2s %9s %8s %12s %12s %9s %6s %8s %6s\n", "case", "quantity", "lvl", "P", "h [m]", "dofs",
-              "value", "reference", "rel_err", "rate", "wall_s", "newton");
+  std::printf("%-11s %-48s %3s %2s %9s %8s %12s %12s %9s %6s %8s %6s\n", "case", "quantity", "lvl", "P", "h [m]",
+              "dofs", "value", "reference", "rel_err", "rate", "wall_s", "newton");
   for (const auto& r : records)
     std::printf("%-11s %-48s %3d %2d %9.3g %8ld %12.6g %12.6g %9.2e %6s %8.2f %6d\n", r.case_name.c_str(),
                 r.quantity.c_str(), r.level, r.order, r.h, r.dofs, r.value, r.reference, r.rel_error,
@@ -80,27 +80,36 @@ int cmd_verify(const std::vector<std::string>& args) {
   bool json = false;
   std::string out_dir = "results/verify";
   for (size_t i = 0; i < args.size(); ++i) {
-    if (args[i] == "--case" && i + 1 < args.size()) options.cases.push_back(args[++i]);
-    else if (args[i] == "--quick") options.quick = true;
-    else if (args[i] == "--hard") options.hard = true;
-    else if (args[i] == "--json") json = true;
-    else if (args[i] == "--out" && i + 1 < args.size()) out_dir = args[++i];
-    else if (args[i].rfind("--", 0) == 0) throw morphfem::InputError("morphfem verify", "unknown option " + args[i]);
+    if (args[i] == "--case" && i + 1 < args.size())
+      options.cases.push_back(args[++i]);
+    else if (args[i] == "--quick")
+      options.quick = true;
+    else if (args[i] == "--hard")
+      options.hard = true;
+    else if (args[i] == "--json")
+      json = true;
+    else if (args[i] == "--out" && i + 1 < args.size())
+      out_dir = args[++i];
+    else if (args[i].rfind("--", 0) == 0)
+      throw morphfem::InputError("morphfem verify", "unknown option " + args[i]);
   }
   options.progress = !json;
   auto records = morphfem::run_verification(options, PETSC_COMM_WORLD);
   if (rank_of_world() != 0) return 0;
   std::string lines;
   for (const auto& r : records) lines += r.json() + "\n";
-  if (json) std::fputs(lines.c_str(), stdout);
-  else print_table(records);
+  if (json)
+    std::fputs(lines.c_str(), stdout);
+  else
+    print_table(records);
   std::filesystem::create_directories(out_dir);
   const std::string jsonl = out_dir + "/verification.jsonl";
   morphfem::write_file_atomic(jsonl, lines);
   const std::string script = std::string(MORPHFEM_SOURCE_DIR) + "/scripts/plot_verification.py";
   if (std::filesystem::exists("/usr/bin/python3") && std::filesystem::exists(script)) {
     const std::string cmd = "/usr/bin/python3 '" + script + "' '" + jsonl + "' '" + out_dir + "' >&2";
-    if (std::system(cmd.c_str()) != 0) std::fprintf(stderr, "morphfem: plotting failed (results are in %s)\n", jsonl.c_str());
+    if (std::system(cmd.c_str()) != 0)
+      std::fprintf(stderr, "morphfem: plotting failed (results are in %s)\n", jsonl.c_str());
   }
   if (!json) std::printf("records: %s; plots: %s/*.png\n", jsonl.c_str(), out_dir.c_str());
   return 0;

@@ -60,10 +60,14 @@ struct Reader {
   std::array<bool, 3> axes(const YAML::Node& node, const std::string& key) const {
     std::array<bool, 3> out{false, false, false};
     for (const auto& name : texts(node, key)) {
-      if (name == "x") out[0] = true;
-      else if (name == "y") out[1] = true;
-      else if (name == "z") out[2] = true;
-      else fail(node, key, "unknown axis '" + name + "' (allowed: x, y, z)");
+      if (name == "x")
+        out[0] = true;
+      else if (name == "y")
+        out[1] = true;
+      else if (name == "z")
+        out[2] = true;
+      else
+        fail(node, key, "unknown axis '" + name + "' (allowed: x, y, z)");
     }
     return out;
   }
@@ -80,8 +84,10 @@ struct Reader {
         p.set(k, values, at(v));
       } else if (v.IsScalar()) {
         double d;
-        if (YAML::convert<double>::decode(v, d)) p.set(k, d, at(v));
-        else p.set_string(k, v.Scalar(), at(v));
+        if (YAML::convert<double>::decode(v, d))
+          p.set(k, d, at(v));
+        else
+          p.set_string(k, v.Scalar(), at(v));
       } else {
         fail(v, context + "." + k, "expected a number, a list of numbers or text");
       }
@@ -116,16 +122,17 @@ Scene read_scene(const std::string& path) {
                      "YAML syntax error: " + e.msg);
   }
   if (!root.IsMap()) throw InputError(path, "a scene must be a mapping with keys geometry/mesh, materials, ...");
-  r.allow(root, "", {"name", "geometry", "mesh", "materials", "boundary", "loads", "solver", "output", "dynamics",
-                     "contact"});
+  r.allow(root, "",
+          {"name", "geometry", "mesh", "materials", "boundary", "loads", "solver", "output", "dynamics", "contact"});
   Scene scene;
   scene.source = path;
   if (root["name"]) scene.name = r.text(root["name"], "name");
 
   // Solver first: load ramps need end_time.
   if (const auto s = root["solver"]) {
-    r.allow(s, "solver", {"end_time", "initial_step", "min_step", "max_step", "linear_solver",
-                          "quadrature_degree", "max_newton_its", "rtol", "formulation"});
+    r.allow(s, "solver",
+            {"end_time", "initial_step", "min_step", "max_step", "linear_solver", "quadrature_degree", "max_newton_its",
+             "rtol", "formulation"});
     auto positive = [&](const char* key, double& out) {
       if (s[key]) {
         out = r.number(s[key], std::string("solver.") + key);
@@ -147,7 +154,8 @@ Scene read_scene(const std::string& path) {
       if (!elastic_formulations().count(scene.formulation)) {
         std::string known;
         for (const auto& [name, f] : elastic_formulations()) known += (known.empty() ? "" : ", ") + name;
-        r.fail(s["formulation"], "solver.formulation", "unknown formulation '" + scene.formulation + "' (known: " + known + ")");
+        r.fail(s["formulation"], "solver.formulation",
+               "unknown formulation '" + scene.formulation + "' (known: " + known + ")");
       }
     }
     if (s["quadrature_degree"]) {
@@ -200,7 +208,8 @@ Scene read_scene(const std::string& path) {
       spec.surface = r.text(item["surface"], "boundary.surface");
       spec.where = r.at(item);
       if (item["fix"] && item["displacement"]) r.fail(item, "boundary", "give either 'fix' or 'displacement'");
-      if (item["fix"]) spec.components = r.axes(item["fix"], "boundary.fix");
+      if (item["fix"])
+        spec.components = r.axes(item["fix"], "boundary.fix");
       else if (item["displacement"]) {
         spec.components = {true, true, true};
         spec.displacement = r.vector3(item["displacement"], "boundary.displacement");
@@ -221,7 +230,8 @@ Scene read_scene(const std::string& path) {
         CavitySpec spec;
         if (!c["surfaces"]) r.fail(c, "loads.cavities", "missing key 'surfaces'");
         if (!c["pressure"]) r.fail(c, "loads.cavities", "missing key 'pressure'");
-        spec.name = c["name"] ? r.text(c["name"], "loads.cavities.name") : "cavity" + std::to_string(scene.cavities.size());
+        spec.name =
+            c["name"] ? r.text(c["name"], "loads.cavities.name") : "cavity" + std::to_string(scene.cavities.size());
         spec.surfaces = r.texts(c["surfaces"], "loads.cavities.surfaces");
         if (c["volume_axes"]) spec.axes = r.axes(c["volume_axes"], "loads.cavities.volume_axes");
         spec.pressure = r.ramp_or_table(c["pressure"], "loads.cavities.pressure", end);
@@ -232,11 +242,13 @@ Scene read_scene(const std::string& path) {
       if (!gs.IsSequence()) r.fail(gs, "loads.gas_cavities", "expected a list");
       for (const auto& c : gs) {
         const std::string key = "loads.gas_cavities";
-        r.allow(c, key, {"name", "surfaces", "volume_axes", "symmetry_factor", "temperature", "initial_gauge_pressure",
-                         "supply_pressure", "conductance"});
+        r.allow(c, key,
+                {"name", "surfaces", "volume_axes", "symmetry_factor", "temperature", "initial_gauge_pressure",
+                 "supply_pressure", "conductance"});
         GasCavitySpec spec;
         if (!c["surfaces"]) r.fail(c, key, "missing key 'surfaces'");
-        spec.wall.name = c["name"] ? r.text(c["name"], key + ".name") : "gas" + std::to_string(scene.gas_cavities.size());
+        spec.wall.name =
+            c["name"] ? r.text(c["name"], key + ".name") : "gas" + std::to_string(scene.gas_cavities.size());
         spec.wall.surfaces = r.texts(c["surfaces"], key + ".surfaces");
         if (c["volume_axes"]) spec.wall.axes = r.axes(c["volume_axes"], key + ".volume_axes");
         auto positive = [&](const char* k, double& out) {
@@ -246,10 +258,12 @@ Scene read_scene(const std::string& path) {
         };
         positive("symmetry_factor", spec.wall.symmetry_factor);
         positive("temperature", spec.temperature);
-        if (c["initial_gauge_pressure"]) spec.initial_gauge_pressure = r.number(c["initial_gauge_pressure"], key + ".initial_gauge_pressure");
+        if (c["initial_gauge_pressure"])
+          spec.initial_gauge_pressure = r.number(c["initial_gauge_pressure"], key + ".initial_gauge_pressure");
         auto constant_or_table = [&](const char* k, TimeFunction& out) {
           if (!c[k]) return;
-          out = c[k].IsScalar() ? TimeFunction::constant(r.number(c[k], key + "." + k)) : r.ramp_or_table(c[k], key + "." + k, end);
+          out = c[k].IsScalar() ? TimeFunction::constant(r.number(c[k], key + "." + k))
+                                : r.ramp_or_table(c[k], key + "." + k, end);
         };
         constant_or_table("supply_pressure", spec.supply_gauge_pressure);
         constant_or_table("conductance", spec.conductance);
@@ -266,8 +280,8 @@ Scene read_scene(const std::string& path) {
         if (!t["surface"] || !t["traction"]) r.fail(t, "loads.tractions", "needs 'surface' and 'traction'");
         spec.surface = r.text(t["surface"], "loads.tractions.surface");
         spec.traction = r.vector3(t["traction"], "loads.tractions.traction");
-        spec.scale = t["scale"] ? r.ramp_or_table(t["scale"], "loads.tractions.scale", end)
-                                : TimeFunction::ramp(1.0, end);
+        spec.scale =
+            t["scale"] ? r.ramp_or_table(t["scale"], "loads.tractions.scale", end) : TimeFunction::ramp(1.0, end);
         spec.where = r.at(t);
         scene.tractions.push_back(spec);
       }
@@ -275,8 +289,9 @@ Scene read_scene(const std::string& path) {
   }
 
   if (const auto d = root["dynamics"]) {
-    r.allow(d, "dynamics", {"scheme", "lumped", "adaptive", "error_tolerance", "shear_viscosity", "bulk_viscosity",
-                            "initial_velocity"});
+    r.allow(
+        d, "dynamics",
+        {"scheme", "lumped", "adaptive", "error_tolerance", "shear_viscosity", "bulk_viscosity", "initial_velocity"});
     scene.dynamic = true;
     if (d["scheme"]) {
       const std::string name = r.text(d["scheme"], "dynamics.scheme");
@@ -327,7 +342,8 @@ Scene read_scene(const std::string& path) {
         scene.friction_spec.eps_v = r.number(f["eps_v"], "contact.friction.eps_v");
         if (!(scene.friction_spec.eps_v > 0)) r.fail(f["eps_v"], "contact.friction.eps_v", "must be positive");
       }
-      if (f["lag_updates"]) scene.friction_spec.lag_updates = int(r.number(f["lag_updates"], "contact.friction.lag_updates"));
+      if (f["lag_updates"])
+        scene.friction_spec.lag_updates = int(r.number(f["lag_updates"], "contact.friction.lag_updates"));
       if (!f["regions"] || !f["regions"].IsSequence())
         r.fail(f, "contact.friction", "missing 'regions: [{surface, mu_static, mu_kinetic}, ...]'");
       for (const auto& reg : f["regions"]) {

@@ -48,8 +48,8 @@
 #include "actuation/gas_cavity.h"
 #include "contact/friction.h"
 #include "contact/ground.h"
-#include "fem/inertia.h"
 #include "core/params.h"
+#include "fem/inertia.h"
 #include "fem/solver.h"
 
 namespace morphfem {
@@ -72,9 +72,9 @@ struct TractionSpec {
 
 struct Scene {
   std::string name = "scene";
-  std::string source;           // file the scene came from ("" if built in code)
-  ParamSet geometry;            // builder parameters (type, sizes, mesh_size, order)
-  std::string mesh_file;        // or a .msh file
+  std::string source;                         // file the scene came from ("" if built in code)
+  ParamSet geometry;                          // builder parameters (type, sizes, mesh_size, order)
+  std::string mesh_file;                      // or a .msh file
   std::map<std::string, ParamSet> materials;  // volume region -> law parameters
   std::vector<BoundarySpec> boundary;
   Eigen::Vector3d gravity = Eigen::Vector3d::Zero();
@@ -88,7 +88,7 @@ struct Scene {
   // Dynamics (inertia, viscous damping) — only if the scene asks for it.
   bool dynamic = false;
   InertiaOptions inertia;
-  double shear_viscosity = 0.0, bulk_viscosity = 0.0;  // [Pa s]
+  double shear_viscosity = 0.0, bulk_viscosity = 0.0;          // [Pa s]
   Eigen::Vector3d initial_velocity = Eigen::Vector3d::Zero();  // [m/s]
   // Ground contact and friction — only if declared.
   bool ground_contact = false;
@@ -98,7 +98,7 @@ struct Scene {
   SolverOptions solver;
   std::string formulation = "displacement";  // elastic element formulation (fem/elastic.h)
   int quadrature_degree = 0;
-  std::string output_dir;       // empty: no files
+  std::string output_dir;  // empty: no files
   int output_every = 1;
 };
 

@@ -8,11 +8,11 @@
 #include <limits>
 
 #include "actuation/cavity.h"
+#include "contact/friction.h"
+#include "contact/ground.h"
 #include "core/errors.h"
 #include "core/json.h"
 #include "core/progress.h"
-#include "contact/friction.h"
-#include "contact/ground.h"
 #include "fem/damping.h"
 #include "fem/elastic.h"
 #include "fem/inertia.h"
@@ -95,7 +95,8 @@ void require_surface(const Scene& scene, const Mesh& mesh, const std::string& na
   if (!mesh.has_region(name, 2)) {
     std::string known;
     for (const auto& n : mesh.region_names(2)) known += (known.empty() ? "" : ", ") + n;
-    throw InputError(scene_key(scene, where, key), "the mesh has no surface region '" + name + "' (it has: " + known + ")");
+    throw InputError(scene_key(scene, where, key),
+                     "the mesh has no surface region '" + name + "' (it has: " + known + ")");
   }
 }
 
@@ -111,7 +112,8 @@ Mesh build_scene_mesh(const Scene& scene, MPI_Comm comm) {
       throw InputError(params.where("model"), "the mesh has no volume region '" + region + "' (it has: " + known + ")");
     }
   for (const auto& name : mesh.region_names(3))
-    if (!scene.materials.count(name)) throw InputError(src + ": materials", "no material for volume region '" + name + "'");
+    if (!scene.materials.count(name))
+      throw InputError(src + ": materials", "no material for volume region '" + name + "'");
   for (const auto& b : scene.boundary) require_surface(scene, mesh, b.surface, b.where, "boundary");
   for (const auto& c : scene.cavities)
     for (const auto& s : c.surfaces) require_surface(scene, mesh, s, "", "loads.cavities." + c.name);
@@ -119,7 +121,8 @@ Mesh build_scene_mesh(const Scene& scene, MPI_Comm comm) {
   for (const auto& c : scene.gas_cavities)
     for (const auto& s : c.wall.surfaces) require_surface(scene, mesh, s, "", "loads.gas_cavities." + c.wall.name);
   if (scene.ground_contact)
-    for (const auto& surface : scene.ground.surfaces) require_surface(scene, mesh, surface, "", "contact.ground.surfaces");
+    for (const auto& surface : scene.ground.surfaces)
+      require_surface(scene, mesh, surface, "", "contact.ground.surfaces");
   if (scene.friction)
     for (const auto& region : scene.friction_spec.regions)
       require_surface(scene, mesh, region.surface, "", "contact.friction.regions");
@@ -167,8 +170,8 @@ SimulationResult run_scene(const Scene& scene, MPI_Comm comm, const RunOptions& 
   if (scene.body_force) {
     std::vector<int> all_cells(mesh.n_cells());
     for (int c = 0; c < mesh.n_cells(); ++c) all_cells[c] = c;
-    assembler.add_term(std::make_shared<BodyForceTerm>(mesh, partition, rank, all_cells, scene.body_force,
-                                                       scene.body_force_degree));
+    assembler.add_term(
+        std::make_shared<BodyForceTerm>(mesh, partition, rank, all_cells, scene.body_force, scene.body_force_degree));
   }
   std::vector<std::shared_ptr<CavityPressureTerm>> cavities;
   for (const auto& spec : scene.cavities) {
@@ -197,7 +200,8 @@ SimulationResult run_scene(const Scene& scene, MPI_Comm comm, const RunOptions& 
     inertia = std::make_shared<InertiaTerm>(mesh, partition, rank, density, scene.inertia);
     assembler.add_term(inertia);
     if (scene.shear_viscosity > 0 || scene.bulk_viscosity > 0) {
-      std::vector<double> eta(mesh.regions.size(), scene.shear_viscosity), zeta(mesh.regions.size(), scene.bulk_viscosity);
+      std::vector<double> eta(mesh.regions.size(), scene.shear_viscosity),
+          zeta(mesh.regions.size(), scene.bulk_viscosity);
       damping = std::make_shared<DampingTerm>(mesh, partition, rank, eta, zeta, scene.inertia.scheme);
       assembler.add_term(damping);
     }
@@ -226,8 +230,10 @@ SimulationResult run_scene(const Scene& scene, MPI_Comm comm, const RunOptions& 
     bc.nodes = mesh.nodes_of_surface(b.surface);
     bc.components = b.components;
     const Eigen::Vector3d d = b.displacement;
-    if (b.field) bc.value = b.field;
-    else bc.value = [d, t_end](const Eigen::Vector3d&, double t) { return Eigen::Vector3d(d * std::min(1.0, t / t_end)); };
+    if (b.field)
+      bc.value = b.field;
+    else
+      bc.value = [d, t_end](const Eigen::Vector3d&, double t) { return Eigen::Vector3d(d * std::min(1.0, t / t_end)); };
     bcs.push_back(bc);
   }
   SolverOptions solver_options = scene.solver;
@@ -312,14 +318,16 @@ SimulationResult run_scene(const Scene& scene, MPI_Comm comm, const RunOptions& 
     std::vector<Field> contact_fields;
     if (ground && write && output_now) {
       auto c = ground->nodal_contact(assembler, solver.solution());
-      contact_fields.push_back(Field{"contact_force_N", 3, std::vector<double>(c.force.data(), c.force.data() + c.force.size())});
+      contact_fields.push_back(
+          Field{"contact_force_N", 3, std::vector<double>(c.force.data(), c.force.data() + c.force.size())});
       for (double& g : c.gap)
         if (!std::isfinite(g)) g = -1.0;  // -1: node not on a contact surface (gaps are always > 0)
       contact_fields.push_back(Field{"contact_gap_m", 1, c.gap});
       contact_fields.push_back(Field{"contact_status", 1, std::vector<double>(c.status.begin(), c.status.end())});
       if (friction) {
         auto f = friction->nodal_friction(assembler, solver.solution());
-        contact_fields.push_back(Field{"friction_force_N", 3, std::vector<double>(f.force.data(), f.force.data() + f.force.size())});
+        contact_fields.push_back(
+            Field{"friction_force_N", 3, std::vector<double>(f.force.data(), f.force.data() + f.force.size())});
         contact_fields.push_back(Field{"friction_status", 1, std::vector<double>(f.status.begin(), f.status.end())});
       }
     }
@@ -382,7 +390,9 @@ SimulationResult run_scene(const Scene& scene, MPI_Comm comm, const RunOptions& 
       std::vector<Json> cavs;
       for (size_t i = 0; i < result.cavity_names.size(); ++i) {
         Json c;
-        c.add("name", result.cavity_names[i]).add("pressure_Pa", result.cavity_pressure[i]).add("volume_m3", result.cavity_volume[i]);
+        c.add("name", result.cavity_names[i])
+            .add("pressure_Pa", result.cavity_pressure[i])
+            .add("volume_m3", result.cavity_volume[i]);
         cavs.push_back(c);
       }
       summary.add("cavities", cavs);

@@ -14,14 +14,14 @@
 namespace morphfem {
 
 struct SimulationResult {
-  Mesh mesh;              // as solved (nodes renumbered by the partitioner)
-  RowMatrixXd u;          // final displacement, n_nodes x 3 [m] (every rank)
+  Mesh mesh;      // as solved (nodes renumbered by the partitioner)
+  RowMatrixXd u;  // final displacement, n_nodes x 3 [m] (every rank)
   RunStats stats;
   long dofs = 0;
   std::vector<std::string> cavity_names;
   std::vector<double> cavity_pressure, cavity_volume;  // final [Pa], [m^3]
-  double min_J = 0;       // smallest det F over quadrature points at the end
-  std::string output_dir; // where results went ("" if none)
+  double min_J = 0;                                    // smallest det F over quadrature points at the end
+  std::string output_dir;                              // where results went ("" if none)
 };
 
 struct RunOptions {

@@ -19,9 +19,19 @@ namespace morphfem {
 
 std::string VerificationRecord::json() const {
   Json j;
-  j.add("case", case_name).add("quantity", quantity).add("level", level).add("order", order).add("h", h)
-      .add("value", value).add("reference", reference).add("rel_error", rel_error).add("rate", rate)
-      .add("dofs", dofs).add("wall_s", wall_s).add("newton_its", newton_its).add("steps", steps)
+  j.add("case", case_name)
+      .add("quantity", quantity)
+      .add("level", level)
+      .add("order", order)
+      .add("h", h)
+      .add("value", value)
+      .add("reference", reference)
+      .add("rel_error", rel_error)
+      .add("rate", rate)
+      .add("dofs", dofs)
+      .add("wall_s", wall_s)
+      .add("newton_its", newton_its)
+      .add("steps", steps)
       .add("step_cuts", step_cuts);
   return j.str();
 }
@@ -42,8 +52,8 @@ Scene verification_scene(const std::string& name, ParamSet geometry, ParamSet ma
   return s;
 }
 
-VerificationRecord verification_record(const std::string& case_name, const std::string& quantity, int level,
-                                       int order, double h, const SimulationResult& r) {
+VerificationRecord verification_record(const std::string& case_name, const std::string& quantity, int level, int order,
+                                       double h, const SimulationResult& r) {
   VerificationRecord rec;
   rec.case_name = case_name;
   rec.quantity = quantity;
@@ -99,9 +109,12 @@ void patch_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<Verificatio
   for (int order : {1, 2})
     for (size_t level = 0; level < divisions.size(); ++level) {
       const double h = L / divisions[level];
-      Scene s = verification_scene("patch", verification_params({{"lx", L}, {"ly", L}, {"lz", L}, {"mesh_size", h}, {"order", double(order)},
-                                            {"distort", 0.25}}, "type", "block"),
-                           verification_params({{"mu", 1e5}, {"kappa", 5e5}}, "model", "neo_hookean"));
+      Scene s = verification_scene(
+          "patch",
+          verification_params(
+              {{"lx", L}, {"ly", L}, {"lz", L}, {"mesh_size", h}, {"order", double(order)}, {"distort", 0.25}}, "type",
+              "block"),
+          verification_params({{"mu", 1e5}, {"kappa", 5e5}}, "model", "neo_hookean"));
       const Mat3 G = F - Mat3::Identity();
       for (const char* face : {"xmin", "xmax", "ymin", "ymax", "zmin", "zmax"}) {
         BoundarySpec b;
@@ -180,9 +193,12 @@ void mms_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<VerificationR
     double prev_L2 = 0, prev_H1 = 0, prev_h = 0;
     for (size_t level = 0; level < divisions.size(); ++level) {
       const double h = L / divisions[level];
-      Scene s = verification_scene("mms", verification_params({{"lx", L}, {"ly", L}, {"lz", L}, {"mesh_size", h}, {"order", double(order)},
-                                          {"structured", 1}}, "type", "block"),
-                           material);
+      Scene s = verification_scene(
+          "mms",
+          verification_params(
+              {{"lx", L}, {"ly", L}, {"lz", L}, {"mesh_size", h}, {"order", double(order)}, {"structured", 1}}, "type",
+              "block"),
+          material);
       for (const char* face : {"xmin", "xmax", "ymin", "ymax", "zmin", "zmax"}) {
         BoundarySpec b;
         b.surface = face;
@@ -257,51 +273,55 @@ void cylinder_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<Verifica
     runs.push_back({2, sizes.size() - 1, 10000.0});
   }
   for (const Run& run : runs) {
-      const int order = run.order;
-      const size_t level = run.level;
-      const double h = sizes[level], kappa = run.kappa_ratio * mu;
-      const std::string suffix = run.kappa_ratio == 1000.0 ? "" : " (kappa/mu=" + std::to_string(int(run.kappa_ratio)) + ")";
-      Scene s = verification_scene("cylinder", verification_params({{"inner_radius", A}, {"outer_radius", B}, {"mesh_size", h},
-                                               {"order", double(order)}}, "type", "thick_cylinder"),
-                           verification_params({{"mu", mu}, {"kappa", kappa}}, "model", "neo_hookean"));
-      for (auto [face, axis] : std::vector<std::pair<const char*, int>>{{"sym_x", 0}, {"sym_y", 1}, {"zmin", 2}, {"zmax", 2}}) {
-        BoundarySpec b;
-        b.surface = face;
-        b.components[axis] = true;
-        s.boundary.push_back(b);
-      }
-      CavitySpec cavity;
-      cavity.name = "bore";
-      cavity.surfaces = {"inner"};
-      cavity.axes = {true, true, false};
-      cavity.pressure = TimeFunction::ramp(p_over_mu * mu, 1.0);
-      s.cavities.push_back(cavity);
-      s.solver.t_end = 1.0;
-      s.solver.dt_initial = 0.1;
-      s.solver.dt_max = 0.25;
-      auto r = run_scene(s, comm, {false, opt.progress, {}});
-      require_completed(r, "thick cylinder");
-      // Inner stretch from the inner wall's vertices: la = mean |x_xy| / A.
-      std::set<int> vertices;
-      for (int f : r.mesh.faces_of("inner"))
-        for (int a = 0; a < 3; ++a) vertices.insert(r.mesh.faces(f, a));
-      double sum = 0;
-      for (int n : vertices) {
-        Eigen::Vector3d x = r.mesh.X.row(n).transpose() + r.u.row(n).transpose();
-        sum += std::hypot(x[0], x[1]);
-      }
-      const double la = sum / vertices.size() / A;
-      auto rec = verification_record("cylinder", "P/mu at computed inner stretch" + suffix, int(level), order, h, r);
-      rec.value = p_over_mu;
-      rec.reference = cylinder_pressure(la, A / B);
-      rec.rel_error = std::abs(rec.value - rec.reference) / rec.reference;
-      out.push_back(rec);
-      auto srec = verification_record("cylinder", "inner stretch (reference 2.0)" + suffix, int(level), order, h, r);
-      srec.value = la;
-      srec.reference = 2.0;
-      srec.rel_error = std::abs(la - 2.0) / 2.0;
-      out.push_back(srec);
+    const int order = run.order;
+    const size_t level = run.level;
+    const double h = sizes[level], kappa = run.kappa_ratio * mu;
+    const std::string suffix =
+        run.kappa_ratio == 1000.0 ? "" : " (kappa/mu=" + std::to_string(int(run.kappa_ratio)) + ")";
+    Scene s = verification_scene(
+        "cylinder",
+        verification_params({{"inner_radius", A}, {"outer_radius", B}, {"mesh_size", h}, {"order", double(order)}},
+                            "type", "thick_cylinder"),
+        verification_params({{"mu", mu}, {"kappa", kappa}}, "model", "neo_hookean"));
+    for (auto [face, axis] :
+         std::vector<std::pair<const char*, int>>{{"sym_x", 0}, {"sym_y", 1}, {"zmin", 2}, {"zmax", 2}}) {
+      BoundarySpec b;
+      b.surface = face;
+      b.components[axis] = true;
+      s.boundary.push_back(b);
     }
+    CavitySpec cavity;
+    cavity.name = "bore";
+    cavity.surfaces = {"inner"};
+    cavity.axes = {true, true, false};
+    cavity.pressure = TimeFunction::ramp(p_over_mu * mu, 1.0);
+    s.cavities.push_back(cavity);
+    s.solver.t_end = 1.0;
+    s.solver.dt_initial = 0.1;
+    s.solver.dt_max = 0.25;
+    auto r = run_scene(s, comm, {false, opt.progress, {}});
+    require_completed(r, "thick cylinder");
+    // Inner stretch from the inner wall's vertices: la = mean |x_xy| / A.
+    std::set<int> vertices;
+    for (int f : r.mesh.faces_of("inner"))
+      for (int a = 0; a < 3; ++a) vertices.insert(r.mesh.faces(f, a));
+    double sum = 0;
+    for (int n : vertices) {
+      Eigen::Vector3d x = r.mesh.X.row(n).transpose() + r.u.row(n).transpose();
+      sum += std::hypot(x[0], x[1]);
+    }
+    const double la = sum / vertices.size() / A;
+    auto rec = verification_record("cylinder", "P/mu at computed inner stretch" + suffix, int(level), order, h, r);
+    rec.value = p_over_mu;
+    rec.reference = cylinder_pressure(la, A / B);
+    rec.rel_error = std::abs(rec.value - rec.reference) / rec.reference;
+    out.push_back(rec);
+    auto srec = verification_record("cylinder", "inner stretch (reference 2.0)" + suffix, int(level), order, h, r);
+    srec.value = la;
+    srec.reference = 2.0;
+    srec.rel_error = std::abs(la - 2.0) / 2.0;
+    out.push_back(srec);
+  }
 }
 
 // ------------------------------------------ case 7: cantilever, dead end load (elastica)
@@ -315,9 +335,12 @@ void cantilever_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<Verifi
     if (opt.quick && order == 1) continue;
     for (size_t level = 0; level < sizes.size(); ++level) {
       const double size = sizes[level];
-      Scene s = verification_scene("cantilever", verification_params({{"L", L}, {"b", b}, {"h", h}, {"mesh_size", size},
-                                                 {"order", double(order)}, {"structured", 1}}, "type", "cantilever"),
-                           verification_params({{"mu", mu}, {"kappa", 2 * mu / 3}}, "model", "neo_hookean"));
+      Scene s = verification_scene(
+          "cantilever",
+          verification_params(
+              {{"L", L}, {"b", b}, {"h", h}, {"mesh_size", size}, {"order", double(order)}, {"structured", 1}}, "type",
+              "cantilever"),
+          verification_params({{"mu", mu}, {"kappa", 2 * mu / 3}}, "model", "neo_hookean"));
       BoundarySpec clamp;
       clamp.surface = "root";
       clamp.components = {true, true, true};
@@ -347,7 +370,8 @@ void cantilever_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<Verifi
       auto r = run_scene(s, comm, run);
       require_completed(r, "cantilever");
       for (const auto& [k, v] : deflection) {
-        auto rec = verification_record("cantilever", "tip deflection v/L, k=" + std::to_string(k), int(level), order, size, r);
+        auto rec =
+            verification_record("cantilever", "tip deflection v/L, k=" + std::to_string(k), int(level), order, size, r);
         rec.value = v;
         rec.reference = reference.at(k);
         rec.rel_error = std::abs(v - rec.reference) / rec.reference;
@@ -370,9 +394,10 @@ void slope_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<Verificatio
   double prev_error = 0, prev_dt = 0;
   for (size_t level = 0; level < steps.size(); ++level) {
     const double dt = steps[level];
-    Scene s = verification_scene("slope", verification_params({{"lx", L}, {"ly", L}, {"lz", L}, {"mesh_size", L / 2},
-                                                               {"order", 1}}, "type", "block"),
-                                 verification_params({{"mu", 1e7}, {"nu", 0.3}, {"density", 1000}}, "model", "neo_hookean"));
+    Scene s = verification_scene(
+        "slope",
+        verification_params({{"lx", L}, {"ly", L}, {"lz", L}, {"mesh_size", L / 2}, {"order", 1}}, "type", "block"),
+        verification_params({{"mu", 1e7}, {"nu", 0.3}, {"density", 1000}}, "model", "neo_hookean"));
     s.gravity = Eigen::Vector3d(g * std::sin(slope), 0, -g * std::cos(slope));
     s.dynamic = true;
     s.inertia.scheme = TimeScheme::implicit_euler;
@@ -416,10 +441,10 @@ void friction_switch_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<V
   double prev_error = 0, prev_dt = 0;
   for (size_t level = 0; level < steps.size(); ++level) {
     const double dt = steps[level];
-    Scene s = verification_scene("friction_switch",
-                                 verification_params({{"lx", L}, {"ly", L}, {"lz", L}, {"mesh_size", L / 2}, {"order", 1}},
-                                                     "type", "block"),
-                                 verification_params({{"mu", 1e7}, {"nu", 0.3}, {"density", 1000}}, "model", "neo_hookean"));
+    Scene s = verification_scene(
+        "friction_switch",
+        verification_params({{"lx", L}, {"ly", L}, {"lz", L}, {"mesh_size", L / 2}, {"order", 1}}, "type", "block"),
+        verification_params({{"mu", 1e7}, {"nu", 0.3}, {"density", 1000}}, "model", "neo_hookean"));
     s.gravity = Eigen::Vector3d(g * std::sin(slope), 0, -g * std::cos(slope));
     s.dynamic = true;
     s.inertia.scheme = TimeScheme::implicit_euler;

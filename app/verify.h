@@ -12,9 +12,9 @@ namespace morphfem {
 struct VerificationRecord {
   std::string case_name, quantity;
   int level = 0, order = 1;
-  double h = 0;            // mesh size [m]
+  double h = 0;  // mesh size [m]
   double value = 0, reference = 0, rel_error = 0;
-  double rate = 0;         // observed convergence rate against the previous level (0: none)
+  double rate = 0;  // observed convergence rate against the previous level (0: none)
   long dofs = 0;
   double wall_s = 0;
   int newton_its = 0, steps = 0, step_cuts = 0;

@@ -21,8 +21,8 @@ ParamSet verification_params(std::initializer_list<std::pair<const char*, double
 // A scene with one volume region "body" of the given material.
 Scene verification_scene(const std::string& name, ParamSet geometry, ParamSet material);
 // A record filled with the run's cost (dofs, wall time, Newton iterations, steps, cuts).
-VerificationRecord verification_record(const std::string& case_name, const std::string& quantity, int level,
-                                       int order, double h, const SimulationResult& r);
+VerificationRecord verification_record(const std::string& case_name, const std::string& quantity, int level, int order,
+                                       double h, const SimulationResult& r);
 // Throws SolveError naming the case if the run did not complete.
 void require_completed(const SimulationResult& r, const std::string& what);
 

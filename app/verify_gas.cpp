@@ -33,15 +33,19 @@ double thick_sphere_pressure(double la, double a_over_b) {
 // Case 5: thin balloon, mid-surface stretch l. Neo-Hookean P/(mu H/R) = 2 (1/l - l^-7);
 // Mooney-Rivlin (C2 = alpha C1) P/(C1 H/R) = 4 (1 + alpha l^2)(1/l - l^-7).
 double balloon_neo_hookean(double l) { return 2.0 * (1.0 / l - std::pow(l, -7)); }
-double balloon_mooney_rivlin(double l, double alpha) { return 4.0 * (1.0 + alpha * l * l) * (1.0 / l - std::pow(l, -7)); }
+double balloon_mooney_rivlin(double l, double alpha) {
+  return 4.0 * (1.0 + alpha * l * l) * (1.0 / l - std::pow(l, -7));
+}
 const double kBalloonMaxStretch = std::pow(7.0, 1.0 / 6.0);  // 1.383088
-const double kBalloonMax = 1.239463;                           // P_max / (mu H/R)
+const double kBalloonMax = 1.239463;                         // P_max / (mu H/R)
 
 // With R the mid-surface radius of a wall of thickness H (A = R - H/2) and the
 // wall incompressible: l^3 = 1 + (la^3 - 1)(A/R)^3 and back. (For H/R = 1/20 the
 // exact thick-wall pressure at mid-surface stretch l differs from the thin formula
 // by < 1e-4 relative at the neo-Hookean maximum and 3e-4 at the MR minimum.)
-double mid_from_inner(double la, double A, double R) { return std::cbrt(1.0 + (la * la * la - 1.0) * std::pow(A / R, 3)); }
+double mid_from_inner(double la, double A, double R) {
+  return std::cbrt(1.0 + (la * la * la - 1.0) * std::pow(A / R, 3));
+}
 double inner_from_mid(double l, double A, double R) { return std::cbrt(1.0 + (l * l * l - 1.0) * std::pow(R / A, 3)); }
 
 // ------------------------------------------------------------------ octant shell
@@ -54,11 +58,11 @@ class OctantShell {
     int size;
     MPI_Comm_size(comm, &size);
     MPI_Comm_rank(comm, &rank_);
-    Scene scene = verification_scene("octant_shell",
-                                     verification_params({{"inner_radius", A}, {"outer_radius", B}, {"mesh_size", h},
-                                                          {"order", double(order)}},
-                                                         "type", "spherical_shell"),
-                                     material);
+    Scene scene = verification_scene(
+        "octant_shell",
+        verification_params({{"inner_radius", A}, {"outer_radius", B}, {"mesh_size", h}, {"order", double(order)}},
+                            "type", "spherical_shell"),
+        material);
     mesh_ = build_scene_mesh(scene, comm);
     partition_ = partition_mesh(mesh_, size);
     std::vector<std::shared_ptr<const Material>> materials(mesh_.regions.size());
@@ -208,7 +212,8 @@ std::pair<double, double> extremum(const std::vector<std::pair<double, double>>&
       best = std::abs(xy[k].first - x_star);
       i = k;
     }
-  return parabola_vertex(xy[i - 1].first, xy[i - 1].second, xy[i].first, xy[i].second, xy[i + 1].first, xy[i + 1].second);
+  return parabola_vertex(xy[i - 1].first, xy[i - 1].second, xy[i].first, xy[i].second, xy[i + 1].first,
+                         xy[i + 1].second);
 }
 
 }  // namespace
@@ -221,13 +226,15 @@ std::pair<double, double> extremum(const std::vector<std::pair<double, double>>&
 void gas_thick_sphere_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<VerificationRecord>& out) {
   const double A = 0.01, B = 0.02, mu = 1e5, kappa = kBulkRatio * mu;
   const std::vector<double> stretches{1.1, 1.5, 1.82815, 2.0, 3.0};
-  const std::vector<double> sizes = opt.quick ? std::vector<double>{A / 1.5} : std::vector<double>{A / 1.5, A / 2.5, A / 4};
+  const std::vector<double> sizes =
+      opt.quick ? std::vector<double>{A / 1.5} : std::vector<double>{A / 1.5, A / 2.5, A / 4};
   const int order = 2;
   for (size_t level = 0; level < sizes.size(); ++level) {
     OctantShell shell(A, B, sizes[level], order,
                       verification_params({{"mu", mu}, {"kappa", kappa}}, "model", "neo_hookean"), comm);
     const double penalty = 10.0 * (4.0 / 3.0) * mu * (1.0 - std::pow(A / B, 3));
-    Trace trace = trace_volume(shell, 3.0, stretches, penalty, 0.1, "sphere level " + std::to_string(level), opt.progress);
+    Trace trace =
+        trace_volume(shell, 3.0, stretches, penalty, 0.1, "sphere level " + std::to_string(level), opt.progress);
     for (double la : stretches) {
       const auto [la_h, p] = trace.samples.at(la);
       char q[96];
@@ -278,19 +285,20 @@ void gas_balloon_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<Verif
     OctantShell shell(g.A, g.B, g.h, order, verification_params({{"mu", mu}, {"kappa", kappa}}, "model", "neo_hookean"),
                       comm);
     const double penalty = 10.0 * 4.0 * mu * g.H / g.R;
-    Trace trace = trace_volume(shell, inner.back(), inner, penalty, 0.05, "balloon level " + std::to_string(level),
-                               opt.progress);
+    Trace trace =
+        trace_volume(shell, inner.back(), inner, penalty, 0.05, "balloon level " + std::to_string(level), opt.progress);
     const auto xy = balloon_curve(trace, g, mu);
     for (const auto& [l, p] : xy) {
       char q[64];
       std::snprintf(q, sizeof q, "P/(mu H/R) at l=%.5f", l);
-      out.push_back(make_record("gas_balloon", q, level, order, g.h, trace.dofs, trace.stats, p, balloon_neo_hookean(l)));
+      out.push_back(
+          make_record("gas_balloon", q, level, order, g.h, trace.dofs, trace.stats, p, balloon_neo_hookean(l)));
     }
     const auto [l_max, p_max] = extremum(xy, ls);
     out.push_back(make_record("gas_balloon", "maximum P/(mu H/R)", level, order, g.h, trace.dofs, trace.stats, p_max,
                               kBalloonMax));
-    out.push_back(make_record("gas_balloon", "stretch at the maximum", level, order, g.h, trace.dofs, trace.stats, l_max,
-                              ls));
+    out.push_back(
+        make_record("gas_balloon", "stretch at the maximum", level, order, g.h, trace.dofs, trace.stats, l_max, ls));
   }
 }
 
@@ -302,15 +310,16 @@ void gas_mooney_balloon_case(const VerifyOptions& opt, MPI_Comm comm, std::vecto
   const double C1 = 5e4, alpha = 0.1, C2 = alpha * C1, kappa = stiff_bulk_ratio() * 2 * (C1 + C2);
   const double l_max = 1.47607, p_max = 2.98124, l_min = 3.14262, p_min = 2.52724;
   const int order = 2;
-  const std::vector<double> mids{1.2,  l_max - 0.04, l_max, l_max + 0.04, 2.0,         2.5,
-                                 3.0,  l_min - 0.08, l_min, l_min + 0.08, 3.5};
+  const std::vector<double> mids{1.2, l_max - 0.04, l_max, l_max + 0.04, 2.0, 2.5,
+                                 3.0, l_min - 0.08, l_min, l_min + 0.08, 3.5};
   const int levels = opt.quick ? 1 : 2;
   for (int level = 0; level < levels; ++level) {
     const BalloonGeometry g = balloon_geometry(opt.quick, level);
     std::vector<double> inner;
     for (double l : mids) inner.push_back(inner_from_mid(l, g.A, g.R));
     OctantShell shell(g.A, g.B, g.h, order,
-                      verification_params({{"c10", C1}, {"c01", C2}, {"kappa", kappa}}, "model", "mooney_rivlin"), comm);
+                      verification_params({{"c10", C1}, {"c01", C2}, {"kappa", kappa}}, "model", "mooney_rivlin"),
+                      comm);
     const double penalty = 10.0 * 4.0 * 2 * (C1 + C2) * g.H / g.R;
     Trace trace = trace_volume(shell, inner.back(), inner, penalty, 0.05, "MR balloon level " + std::to_string(level),
                                opt.progress);
@@ -325,12 +334,12 @@ void gas_mooney_balloon_case(const VerifyOptions& opt, MPI_Comm comm, std::vecto
     const auto mn = extremum(xy, l_min);
     out.push_back(make_record("gas_mooney_balloon", "maximum P/(C1 H/R)", level, order, g.h, trace.dofs, trace.stats,
                               mx.second, p_max));
-    out.push_back(make_record("gas_mooney_balloon", "stretch at the maximum", level, order, g.h, trace.dofs, trace.stats,
-                              mx.first, l_max));
+    out.push_back(make_record("gas_mooney_balloon", "stretch at the maximum", level, order, g.h, trace.dofs,
+                              trace.stats, mx.first, l_max));
     out.push_back(make_record("gas_mooney_balloon", "minimum P/(C1 H/R)", level, order, g.h, trace.dofs, trace.stats,
                               mn.second, p_min));
-    out.push_back(make_record("gas_mooney_balloon", "stretch at the minimum", level, order, g.h, trace.dofs, trace.stats,
-                              mn.first, l_min));
+    out.push_back(make_record("gas_mooney_balloon", "stretch at the minimum", level, order, g.h, trace.dofs,
+                              trace.stats, mn.first, l_min));
   }
 }
 
@@ -341,7 +350,8 @@ void gas_mooney_balloon_case(const VerifyOptions& opt, MPI_Comm comm, std::vecto
 PressureControlFailure run_pressure_controlled_balloon(bool quick, MPI_Comm comm) {
   const double mu = 1e5, kappa = kBulkRatio * mu;
   const BalloonGeometry g = balloon_geometry(quick, 0);
-  OctantShell shell(g.A, g.B, g.h, 2, verification_params({{"mu", mu}, {"kappa", kappa}}, "model", "neo_hookean"), comm);
+  OctantShell shell(g.A, g.B, g.h, 2, verification_params({{"mu", mu}, {"kappa", kappa}}, "model", "neo_hookean"),
+                    comm);
   PressureControlFailure result;
   result.max_pressure_exact = kBalloonMax * mu * g.H / g.R;
   CavitySpec spec;
@@ -377,8 +387,8 @@ void gas_pressure_control_failure_case(const VerifyOptions& opt, MPI_Comm comm, 
   const BalloonGeometry g = balloon_geometry(opt.quick, 0);
   // Value: the last converged pressure relative to the exact maximum (how close to
   // the limit point pressure control got before stopping).
-  auto rec = make_record("gas_pressure_control_failure", "last converged P / P_max (expected failure)", 0, 2, g.h, r.dofs,
-                         r.stats, r.last_pressure / r.max_pressure_exact, 1.0);
+  auto rec = make_record("gas_pressure_control_failure", "last converged P / P_max (expected failure)", 0, 2, g.h,
+                         r.dofs, r.stats, r.last_pressure / r.max_pressure_exact, 1.0);
   out.push_back(rec);
 }
 
@@ -400,8 +410,7 @@ struct FillResult {
 FillResult fill_time(double supply, double C, double initial_gauge, double target, bool quick, MPI_Comm comm) {
   const double A = 0.01, B = 0.02, mu = 1e8;
   const double h = quick ? A : A / 2;
-  OctantShell shell(A, B, h, 1, verification_params({{"mu", mu}, {"kappa", 3 * mu}}, "model", "neo_hookean"),
-                    comm);
+  OctantShell shell(A, B, h, 1, verification_params({{"mu", mu}, {"kappa", 3 * mu}}, "model", "neo_hookean"), comm);
   GasCavitySpec spec;
   spec.wall = shell.wall();
   spec.initial_gauge_pressure = initial_gauge;
@@ -422,7 +431,8 @@ FillResult fill_time(double supply, double C, double initial_gauge, double targe
   r.time = -1;
   r.stats = solver.run([&](const StepReport& s) {
     const double p = gas->pressure();
-    if (r.time < 0 && (p - target) * (supply - target) >= 0) r.time = t_prev + (s.t - t_prev) * (target - p_prev) / (p - p_prev);
+    if (r.time < 0 && (p - target) * (supply - target) >= 0)
+      r.time = t_prev + (s.t - t_prev) * (target - p_prev) / (p - p_prev);
     t_prev = s.t;
     p_prev = p;
   });
@@ -443,7 +453,8 @@ void gas_valve_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<Verific
                               {"vacuum -80 kPa from +50 kPa to 0, C", -80e3, C, 50e3, 0}};
   for (const auto& run : runs) {
     const auto r = fill_time(run.supply, run.C, run.initial, run.target, opt.quick, comm);
-    out.push_back(make_record("gas_valve", std::string(run.what) + " [s]", 0, 1, r.h, r.dofs, r.stats, r.time, r.expected));
+    out.push_back(
+        make_record("gas_valve", std::string(run.what) + " [s]", 0, 1, r.h, r.dofs, r.stats, r.time, r.expected));
   }
 }
 

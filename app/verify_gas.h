@@ -35,11 +35,11 @@ void gas_valve_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<Verific
 // Result of the pressure-controlled balloon run behind case (d) (exposed for the test).
 struct PressureControlFailure {
   RunStats stats;
-  double last_pressure = 0;      // gauge pressure of the last converged state [Pa]
-  double max_pressure_exact = 0; // thin-balloon maximum 1.239463 mu H/R [Pa]
-  double last_time = 0;          // time of the last converged state [s]
-  bool state_finite = false;     // the kept solution has only finite entries
-  double last_volume_ratio = 0;  // V/V_ref of the kept state (from the solution vector)
+  double last_pressure = 0;       // gauge pressure of the last converged state [Pa]
+  double max_pressure_exact = 0;  // thin-balloon maximum 1.239463 mu H/R [Pa]
+  double last_time = 0;           // time of the last converged state [s]
+  bool state_finite = false;      // the kept solution has only finite entries
+  double last_volume_ratio = 0;   // V/V_ref of the kept state (from the solution vector)
   long dofs = 0;
 };
 PressureControlFailure run_pressure_controlled_balloon(bool quick, MPI_Comm comm);

@@ -44,7 +44,8 @@ double mean_displacement_on_z_line(const Mesh& mesh, const RowMatrixXd& u, doubl
       sum += u(n, i);
       ++count;
     }
-  if (count == 0) throw SolveError("verification: no node on the line (" + std::to_string(x0) + ", " + std::to_string(y0) + ")");
+  if (count == 0)
+    throw SolveError("verification: no node on the line (" + std::to_string(x0) + ", " + std::to_string(y0) + ")");
   return sum / count;
 }
 
@@ -128,7 +129,8 @@ CookResult run_cook(int divisions, int order, const std::string& formulation, do
                     MPI_Comm comm) {
   const double h = 0.048 / divisions;  // [m], divisions per side of the trapezoid
   Scene s = verification_scene(
-      "cook", verification_params({{"mesh_size", h}, {"order", double(order)}, {"structured", 1}}, "type", "cook_membrane"),
+      "cook",
+      verification_params({{"mesh_size", h}, {"order", double(order)}, {"structured", 1}}, "type", "cook_membrane"),
       verification_params({{"mu", mu}, {"kappa", kappa}}, "model", "neo_hookean"));
   s.formulation = formulation;
   s.boundary = {fixed("left", true, true, true), fixed("zmin", false, false, true), fixed("zmax", false, false, true)};
@@ -152,9 +154,9 @@ CookResult run_cook(int divisions, int order, const std::string& formulation, do
 // conservative end moment M(t) = M t / t_end about y, built with the lower-level API
 // (the Scene has no end-moment load).
 struct EndMomentResult {
-  SimulationResult run;            // stats, dofs, min_J
-  std::vector<double> theta;       // section angle at the sample times [rad]
-  std::vector<Eigen::Vector3d> tip;  // tip-face mean displacement at the sample times [m]
+  SimulationResult run;                    // stats, dofs, min_J
+  std::vector<double> theta;               // section angle at the sample times [rad]
+  std::vector<Eigen::Vector3d> tip;        // tip-face mean displacement at the sample times [m]
   Eigen::Vector3d tip_final, root_centre;  // current tip-face centre, reference root centre [m]
 };
 
@@ -165,7 +167,7 @@ EndMomentResult run_end_moment(double L, double h, double mesh_size, double mu, 
   MPI_Comm_rank(comm, &rank);
   MPI_Comm_size(comm, &size);
   const double b = h, E = 2.0 * mu, I = b * h * h * h / 12.0;  // nu = 0: E = 2 mu, kappa = 2 mu / 3
-  const double M = theta_end * E * I / L;                         // elastica: theta = M L / (E I)
+  const double M = theta_end * E * I / L;                      // elastica: theta = M L / (E I)
   Scene scene = verification_scene(
       "end_moment",
       verification_params({{"L", L}, {"b", b}, {"h", h}, {"mesh_size", mesh_size}, {"order", 2.0}, {"structured", 1}},
@@ -274,12 +276,13 @@ void cook_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<Verification
     for (size_t level = 0; level < ladder.divisions.size(); ++level) {
       const double h = 0.048 / ladder.divisions[level];
       CookResult r = run_cook(ladder.divisions[level], ladder.order, ladder.formulation, mu, kappa, opt.progress, comm);
-      auto rec = verification_record("cook", std::string("tip vertical displacement [mm] (") + ladder.formulation + ")", int(level),
-                                     ladder.order, h, r.run);
+      auto rec = verification_record("cook", std::string("tip vertical displacement [mm] (") + ladder.formulation + ")",
+                                     int(level), ladder.order, h, r.run);
       rec.value = r.tip_mm;
       rec.reference = kCookReference_mm;
       rec.rel_error = rel_error(r.tip_mm, kCookReference_mm);
-      if (level > 0 && prev_err > 0 && rec.rel_error > 0) rec.rate = std::log(prev_err / rec.rel_error) / std::log(prev_h / h);
+      if (level > 0 && prev_err > 0 && rec.rel_error > 0)
+        rec.rate = std::log(prev_err / rec.rel_error) / std::log(prev_h / h);
       prev_err = rec.rel_error;
       prev_h = h;
       out.push_back(rec);
@@ -304,22 +307,24 @@ void incompressible_block_case(const VerifyOptions& opt, MPI_Comm comm, std::vec
 
   {  // (1) homogeneous uniaxial tension
     const double stretch = 1.5, h = L / 2;
-    Scene s = verification_scene("block_uniaxial",
-                                 verification_params({{"lx", L}, {"ly", L}, {"lz", L}, {"mesh_size", h}, {"order", 2},
-                                                      {"structured", 1}}, "type", "block"),
-                                 material);
+    Scene s = verification_scene(
+        "block_uniaxial",
+        verification_params({{"lx", L}, {"ly", L}, {"lz", L}, {"mesh_size", h}, {"order", 2}, {"structured", 1}},
+                            "type", "block"),
+        material);
     s.formulation = "mean_dilatation";
     BoundarySpec top = fixed("zmax", false, false, true);
     top.displacement = Eigen::Vector3d(0, 0, (stretch - 1.0) * L);
-    s.boundary = {fixed("xmin", true, false, false), fixed("ymin", false, true, false), fixed("zmin", false, false, true), top};
+    s.boundary = {fixed("xmin", true, false, false), fixed("ymin", false, true, false),
+                  fixed("zmin", false, false, true), top};
     s.solver.dt_initial = 0.05;  // kappa / mu = 5000: small load steps keep Newton in its basin
     s.solver.dt_max = 0.1;
     auto r = run_scene(s, comm, {false, opt.progress, {}});
     require_completed(r, "incompressible block, uniaxial tension");
     double lateral, P33;
     uniaxial_state(*law, stretch, lateral, P33);
-    auto rec = verification_record("incompressible_block", "uniaxial stretch 1.5, platen force [N] (mean_dilatation)", 0,
-                                   2, h, r);
+    auto rec = verification_record("incompressible_block", "uniaxial stretch 1.5, platen force [N] (mean_dilatation)",
+                                   0, 2, h, r);
     rec.value = elastic_reaction(r.mesh, r.u, "mean_dilatation", law, r.mesh.nodes_of_surface("zmax"), 2);
     rec.reference = P33 * L * L;
     rec.rel_error = rel_error(rec.value, rec.reference);
@@ -333,10 +338,11 @@ void incompressible_block_case(const VerifyOptions& opt, MPI_Comm comm, std::vec
     for (int n : divisions) {
       if (formulation == "displacement" && n > 4) continue;  // locks; 109 s at n = 6 for no new information
       const double h = L / n;
-      Scene s = verification_scene("block_shear",
-                                   verification_params({{"lx", L}, {"ly", L}, {"lz", L}, {"mesh_size", h}, {"order", 2},
-                                                        {"structured", 1}}, "type", "block"),
-                                   material);
+      Scene s = verification_scene(
+          "block_shear",
+          verification_params({{"lx", L}, {"ly", L}, {"lz", L}, {"mesh_size", h}, {"order", 2}, {"structured", 1}},
+                              "type", "block"),
+          material);
       s.formulation = formulation;
       s.boundary = {fixed("zmin", true, true, true)};
       TractionSpec shear;
@@ -357,10 +363,10 @@ void incompressible_block_case(const VerifyOptions& opt, MPI_Comm comm, std::vec
   for (const auto& [formulation, list] : runs)
     for (size_t level = 0; level < list.size(); ++level) {
       const auto& [r, ux] = list[level];
-      auto rec = verification_record("incompressible_block",
-                                     "bonded cube, top shear 0.2 mu: mean top u_x [m] (" + formulation +
-                                         "; reference: finest mean_dilatation)",
-                                     int(level), 2, L / divisions[level], r);
+      auto rec = verification_record(
+          "incompressible_block",
+          "bonded cube, top shear 0.2 mu: mean top u_x [m] (" + formulation + "; reference: finest mean_dilatation)",
+          int(level), 2, L / divisions[level], r);
       rec.value = ux;
       rec.reference = reference;
       rec.rel_error = rel_error(ux, reference);
@@ -388,15 +394,19 @@ void compression_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<Verif
   std::shared_ptr<const Material> law = make_material(material);
   const std::string formulation = "mean_dilatation";
   auto scene = [&](double h, bool bonded) {
-    Scene s = verification_scene("compression",
-                                 verification_params({{"lx", L}, {"ly", L}, {"lz", L}, {"mesh_size", h}, {"order", 2},
-                                                      {"structured", 1}}, "type", "block"),
-                                 material);
+    Scene s = verification_scene(
+        "compression",
+        verification_params({{"lx", L}, {"ly", L}, {"lz", L}, {"mesh_size", h}, {"order", 2}, {"structured", 1}},
+                            "type", "block"),
+        material);
     s.formulation = formulation;
     BoundarySpec top = fixed("zmax", bonded, bonded, true);
     top.displacement = Eigen::Vector3d(0, 0, -0.5 * L);
-    if (bonded) s.boundary = {fixed("zmin", true, true, true), top};
-    else s.boundary = {fixed("xmin", true, false, false), fixed("ymin", false, true, false), fixed("zmin", false, false, true), top};
+    if (bonded)
+      s.boundary = {fixed("zmin", true, true, true), top};
+    else
+      s.boundary = {fixed("xmin", true, false, false), fixed("ymin", false, true, false),
+                    fixed("zmin", false, false, true), top};
     s.solver.dt_initial = 0.05;
     s.solver.dt_max = 0.05;
     return s;
@@ -427,9 +437,9 @@ void compression_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<Verif
       // Recorded, not thrown: how far the compression got (fraction of the 50 %)
       // before the solver gave up (typically a corner cell at a bonded edge folding).
       const auto top = r.mesh.nodes_of_surface("zmax");
-      auto rec = verification_record("compression", "bonded 50 %: FAILED, fraction of the compression reached (" +
-                                                        r.stats.failure + ")",
-                                     int(level), 2, L / divisions[level], r);
+      auto rec = verification_record(
+          "compression", "bonded 50 %: FAILED, fraction of the compression reached (" + r.stats.failure + ")",
+          int(level), 2, L / divisions[level], r);
       rec.value = -r.u(top[0], 2) / (0.5 * L);
       rec.reference = 1.0;
       rec.rel_error = rel_error(rec.value, 1.0);
@@ -480,14 +490,16 @@ void end_moment_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<Verifi
       // Tip displacement against the circle, relative to L.
       const double u_exact = -(1.0 - std::sin(theta) / theta), v_exact = (1.0 - std::cos(theta)) / theta;
       const double err = std::hypot(r.tip[k][0] / L - u_exact, r.tip[k][2] / L - v_exact);
-      auto tip = verification_record("end_moment", "tip displacement error / L" + at, int(level), 2, sizes[level], r.run);
+      auto tip =
+          verification_record("end_moment", "tip displacement error / L" + at, int(level), 2, sizes[level], r.run);
       tip.value = err;
       tip.reference = 0.0;
       tip.rel_error = err;
       out.push_back(tip);
     }
     if (!opt.quick) {
-      auto gap = verification_record("end_moment", "closed circle: |x_tip - X_root| / L", int(level), 2, sizes[level], r.run);
+      auto gap =
+          verification_record("end_moment", "closed circle: |x_tip - X_root| / L", int(level), 2, sizes[level], r.run);
       gap.value = (r.tip_final - r.root_centre).norm() / L;
       gap.reference = 0.0;
       gap.rel_error = gap.value;

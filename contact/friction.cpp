@@ -96,9 +96,7 @@ void FrictionTerm::set_time(double t) {
   }
 }
 
-FrictionLaw FrictionTerm::law(int k) const {
-  return FrictionLaw{mu_s_[k], mu_k_[k], spec_.eps_v * h_};
-}
+FrictionLaw FrictionTerm::law(int k) const { return FrictionLaw{mu_s_[k], mu_k_[k], spec_.eps_v * h_}; }
 
 void FrictionTerm::compute_normal_forces(Assembler& assembler, Vec u, std::vector<double>& lambda) const {
   const std::vector<double>& u_local = assembler.gather(u);

@@ -69,10 +69,10 @@ struct FrictionSpec {
 // smoothing width eps [m] (see the header comment). Exposed for tests.
 struct FrictionLaw {
   double mu_s = 0.0, mu_k = 0.0, eps = 1.0;
-  double potential(double y) const;   // F(y)
-  double force(double y) const;       // phi(y)
+  double potential(double y) const;     // F(y)
+  double force(double y) const;         // phi(y)
   double force_over_y(double y) const;  // phi(y)/y, finite at y = 0
-  double dforce(double y) const;      // phi'(y)
+  double dforce(double y) const;        // phi'(y)
 };
 
 class FrictionTerm : public EnergyTerm {

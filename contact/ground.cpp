@@ -81,8 +81,9 @@ GroundContactTerm::GroundContactTerm(const Mesh& mesh, const Partition& partitio
     if (!(d > 0)) {
       std::ostringstream msg;
       msg << "node " << a << " at (" << mesh.X(a, 0) << ", " << mesh.X(a, 1) << ", " << mesh.X(a, 2)
-          << ") starts at gap " << d << " m <= 0 from the plane: place the body above it (a gap of about dhat/2 = "
-          << 0.5 * spec_.dhat << " m rests in contact)";
+          << ") starts at gap " << d
+          << " m <= 0 from the plane: place the body above it (a gap of about dhat/2 = " << 0.5 * spec_.dhat
+          << " m rests in contact)";
       throw InputError(where, msg.str());
     }
   }
@@ -98,8 +99,10 @@ double GroundContactTerm::resting_gap(double pressure) const {
   double lo = 0.0, hi = 1.0;  // in units of dhat; -phi' decreases from +inf to 0 on (0, 1)
   for (int it = 0; it < 200 && hi - lo > 1e-15; ++it) {
     const double mid = 0.5 * (lo + hi);
-    if (spec_.kappa * -barrier_dphi(mid) > pressure) lo = mid;
-    else hi = mid;
+    if (spec_.kappa * -barrier_dphi(mid) > pressure)
+      lo = mid;
+    else
+      hi = mid;
   }
   return 0.5 * (lo + hi) * spec_.dhat;
 }

@@ -48,10 +48,10 @@ struct GroundContactSpec {
   Eigen::Vector3d point{0.0, 0.0, 0.0};   // p0 [m], a point of the plane
   Eigen::Vector3d normal{0.0, 0.0, 1.0};  // n (normalised here), ground -> body side
   std::vector<std::string> surfaces;      // surface regions whose nodes touch the plane
-  double dhat = 0.0;    // barrier width [m]; <= 0: 1e-3 x bounding-box diagonal
-  double kappa = 0.0;   // barrier stiffness [Pa]; <= 0: young_modulus
-  double young_modulus = 0.0;  // [Pa], used only for the default kappa
-  double max_step_fraction = 0.9;  // s in (0, 1): a Newton step may close at most s of a gap
+  double dhat = 0.0;                      // barrier width [m]; <= 0: 1e-3 x bounding-box diagonal
+  double kappa = 0.0;                     // barrier stiffness [Pa]; <= 0: young_modulus
+  double young_modulus = 0.0;             // [Pa], used only for the default kappa
+  double max_step_fraction = 0.9;         // s in (0, 1): a Newton step may close at most s of a gap
 };
 
 // Nodal area weights [m^2] of the given faces (reference configuration), one entry
@@ -109,9 +109,9 @@ class GroundContactTerm : public EnergyTerm {
  private:
   const Mesh& mesh_;
   GroundContactSpec spec_;
-  std::vector<double> weight_;     // per mesh node [m^2]
-  std::vector<int> all_nodes_;     // contact nodes (weight > 0)
-  std::vector<int> owned_nodes_;   // those this rank owns = pieces
+  std::vector<double> weight_;    // per mesh node [m^2]
+  std::vector<int> all_nodes_;    // contact nodes (weight > 0)
+  std::vector<int> owned_nodes_;  // those this rank owns = pieces
 };
 
 }  // namespace morphfem

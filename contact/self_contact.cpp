@@ -93,9 +93,12 @@ Feature closest_feature(const Eigen::Matrix<double, 4, 3>& x) {
     const double d2 = (p - (xi + t * (xj - xi))).squaredNorm();
     if (d2 < best_d2) {
       best_d2 = d2;
-      if (t <= 0) best = Feature{1, e[0], e[0]};
-      else if (t >= 1) best = Feature{1, e[1], e[1]};
-      else best = Feature{2, e[0], e[1]};
+      if (t <= 0)
+        best = Feature{1, e[0], e[0]};
+      else if (t >= 1)
+        best = Feature{1, e[1], e[1]};
+      else
+        best = Feature{2, e[0], e[1]};
     }
   }
   return best;
@@ -233,8 +236,7 @@ void SelfContactTerm::build_candidates(const RowMatrixXd& x) {
     for (const auto& [points, tris] : {std::pair{&side_a, &side_b}, std::pair{&side_b, &side_a}}) {
       double size = reach;
       for (const auto& t : tris->triangles)
-        for (int i = 0; i < 3; ++i)
-          size = std::max(size, (x.row(t[i]) - x.row(t[(i + 1) % 3])).cwiseAbs().maxCoeff());
+        for (int i = 0; i < 3; ++i) size = std::max(size, (x.row(t[i]) - x.row(t[(i + 1) % 3])).cwiseAbs().maxCoeff());
       const auto cell = [&](const Eigen::Vector3d& y) {
         return std::make_tuple(static_cast<long>(std::floor(y[0] / size)), static_cast<long>(std::floor(y[1] / size)),
                                static_cast<long>(std::floor(y[2] / size)));

@@ -100,8 +100,8 @@ class SelfContactTerm : public EnergyTerm {
     std::vector<int> triangle_face;  // parent face of each triangle
   };
   std::vector<std::pair<Side, Side>> sides_;
-  std::vector<Pair> pairs_;             // owned pairs (owner of the point)
-  std::vector<int> trust_nodes_;        // owned surface nodes
+  std::vector<Pair> pairs_;              // owned pairs (owner of the point)
+  std::vector<int> trust_nodes_;         // owned surface nodes
   std::vector<Eigen::Vector3d> anchor_;  // per mesh node: displacement at the last refresh [m]
 };
 

@@ -19,9 +19,7 @@ void ParamSet::set_string(const std::string& key, std::string value, std::string
   where_[key] = std::move(where);
 }
 
-bool ParamSet::has(const std::string& key) const {
-  return numbers_.count(key) > 0 || strings_.count(key) > 0;
-}
+bool ParamSet::has(const std::string& key) const { return numbers_.count(key) > 0 || strings_.count(key) > 0; }
 
 std::string ParamSet::where(const std::string& key) const {
   auto it = where_.find(key);
@@ -61,14 +59,11 @@ std::vector<double> ParamSet::list(const std::string& key, std::vector<double> f
 
 double ParamSet::number(const std::string& key) const {
   auto v = list(key);
-  if (v.size() != 1)
-    throw InputError(where(key), "expected one number, got " + std::to_string(v.size()));
+  if (v.size() != 1) throw InputError(where(key), "expected one number, got " + std::to_string(v.size()));
   return v[0];
 }
 
-double ParamSet::number(const std::string& key, double fallback) const {
-  return has(key) ? number(key) : fallback;
-}
+double ParamSet::number(const std::string& key, double fallback) const { return has(key) ? number(key) : fallback; }
 
 double ParamSet::number_in(const std::string& key, double lo, double hi) const {
   double v = number(key);

@@ -10,9 +10,12 @@ namespace morphfem {
 std::string format_seconds(double s) {
   char buf[32];
   if (s < 0 || s != s) return "--";
-  if (s < 60) std::snprintf(buf, sizeof buf, "%.1fs", s);
-  else if (s < 3600) std::snprintf(buf, sizeof buf, "%dm%02ds", int(s) / 60, int(s) % 60);
-  else std::snprintf(buf, sizeof buf, "%dh%02dm", int(s) / 3600, (int(s) % 3600) / 60);
+  if (s < 60)
+    std::snprintf(buf, sizeof buf, "%.1fs", s);
+  else if (s < 3600)
+    std::snprintf(buf, sizeof buf, "%dm%02ds", int(s) / 60, int(s) % 60);
+  else
+    std::snprintf(buf, sizeof buf, "%dh%02dm", int(s) / 3600, (int(s) % 3600) / 60);
   return buf;
 }
 
@@ -43,9 +46,9 @@ void Progress::update(double done, const std::string& info) {
   int filled = static_cast<int>(frac * width + 0.5);
   std::string bar(std::max(0, std::min(width, filled)), '#');
   bar.resize(width, '.');
-  std::fprintf(stderr, "%s%s [%s] %5.1f%% elapsed %s ETA %s %s%s", tty_ ? "\r" : "", label_.c_str(),
-               bar.c_str(), 100.0 * frac, format_seconds(elapsed).c_str(), format_seconds(eta).c_str(),
-               info.c_str(), tty_ ? "\033[K" : "\n");
+  std::fprintf(stderr, "%s%s [%s] %5.1f%% elapsed %s ETA %s %s%s", tty_ ? "\r" : "", label_.c_str(), bar.c_str(),
+               100.0 * frac, format_seconds(elapsed).c_str(), format_seconds(eta).c_str(), info.c_str(),
+               tty_ ? "\033[K" : "\n");
   std::fflush(stderr);
 }
 

@@ -46,8 +46,7 @@ Mat Assembler::create_matrix() const {
   return m;
 }
 
-void Assembler::load_piece(int k, const EnergyTerm& term, PieceState& s,
-                           std::vector<int>& nodes) const {
+void Assembler::load_piece(int k, const EnergyTerm& term, PieceState& s, std::vector<int>& nodes) const {
   term.piece_nodes(k, nodes);
   const int n = static_cast<int>(nodes.size());
   s.X.resize(n, 3);
@@ -109,8 +108,8 @@ void Assembler::setup() {
       for (int n : nodes)
         for (int i = 0; i < 3; ++i) idx.push_back(constrained_[3 * n + i] ? -1 : 3 * n + i);
       zeros.assign(idx.size() * idx.size(), 0.0);
-      PETSC_CHECK(MatSetValues(pre, static_cast<PetscInt>(idx.size()), idx.data(),
-                               static_cast<PetscInt>(idx.size()), idx.data(), zeros.data(), ADD_VALUES));
+      PETSC_CHECK(MatSetValues(pre, static_cast<PetscInt>(idx.size()), idx.data(), static_cast<PetscInt>(idx.size()),
+                               idx.data(), zeros.data(), ADD_VALUES));
     }
   for (PetscInt d = owned_dof_begin(); d < owned_dof_end(); ++d) {
     PetscScalar zero = 0.0;
@@ -183,11 +182,13 @@ double Assembler::gradient(Vec u, Vec gvec) {
   PETSC_CHECK(VecSet(gvec, 0.0));
   // Constrained dofs carry index -1; PETSc vectors skip them only with this option.
   PETSC_CHECK(VecSetOption(gvec, VEC_IGNORE_NEGATIVE_INDICES, PETSC_TRUE));
-  double e = sweep(u, true, false, [&](size_t, int, const std::vector<PetscInt>& idx, double energy,
-                                       const Eigen::VectorXd& g, const Eigen::MatrixXd&) {
-    if (!std::isfinite(energy)) return;  // outside the domain: no meaningful gradient
-    PETSC_CHECK(VecSetValues(gvec, static_cast<PetscInt>(idx.size()), idx.data(), g.data(), ADD_VALUES));
-  });
+  double e =
+      sweep(u, true, false,
+            [&](size_t, int, const std::vector<PetscInt>& idx, double energy, const Eigen::VectorXd& g,
+                const Eigen::MatrixXd&) {
+              if (!std::isfinite(energy)) return;  // outside the domain: no meaningful gradient
+              PETSC_CHECK(VecSetValues(gvec, static_cast<PetscInt>(idx.size()), idx.data(), g.data(), ADD_VALUES));
+            });
   PETSC_CHECK(VecAssemblyBegin(gvec));
   PETSC_CHECK(VecAssemblyEnd(gvec));
   return e;
@@ -195,12 +196,13 @@ double Assembler::gradient(Vec u, Vec gvec) {
 
 void Assembler::hessian(Vec u, Mat Hmat) {
   PETSC_CHECK(MatZeroEntries(Hmat));
-  sweep(u, false, true, [&](size_t, int, const std::vector<PetscInt>& idx, double energy,
-                            const Eigen::VectorXd&, const Eigen::MatrixXd& H) {
-    if (!std::isfinite(energy)) return;
-    const PetscInt n = static_cast<PetscInt>(idx.size());
-    PETSC_CHECK(MatSetValues(Hmat, n, idx.data(), n, idx.data(), H.data(), ADD_VALUES));
-  });
+  sweep(u, false, true,
+        [&](size_t, int, const std::vector<PetscInt>& idx, double energy, const Eigen::VectorXd&,
+            const Eigen::MatrixXd& H) {
+          if (!std::isfinite(energy)) return;
+          const PetscInt n = static_cast<PetscInt>(idx.size());
+          PETSC_CHECK(MatSetValues(Hmat, n, idx.data(), n, idx.data(), H.data(), ADD_VALUES));
+        });
   for (PetscInt d = owned_dof_begin(); d < owned_dof_end(); ++d)
     if (constrained_[d]) PETSC_CHECK(MatSetValue(Hmat, d, d, 1.0, ADD_VALUES));
   PETSC_CHECK(MatAssemblyBegin(Hmat, MAT_FINAL_ASSEMBLY));
@@ -226,8 +228,7 @@ RowMatrixXd Assembler::gather_all(Vec u) const {
 void Assembler::scatter_all(const RowMatrixXd& field, Vec u) const {
   PetscScalar* a;
   PETSC_CHECK(VecGetArray(u, &a));
-  for (PetscInt d = owned_dof_begin(); d < owned_dof_end(); ++d)
-    a[d - owned_dof_begin()] = field(d / 3, d % 3);
+  for (PetscInt d = owned_dof_begin(); d < owned_dof_end(); ++d) a[d - owned_dof_begin()] = field(d / 3, d % 3);
   PETSC_CHECK(VecRestoreArray(u, &a));
 }
 

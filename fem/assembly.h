@@ -79,13 +79,13 @@ class Assembler {
   MPI_Comm comm_;
   int rank_ = 0;
   std::vector<std::shared_ptr<EnergyTerm>> terms_;
-  std::vector<char> constrained_;   // per global dof
-  std::vector<int> slot_;           // global node -> slot in ghost array (-1)
-  std::vector<int> ghost_nodes_;    // nodes needed on this rank, sorted
-  std::vector<double> ghost_u_;     // 3 per ghost node
+  std::vector<char> constrained_;  // per global dof
+  std::vector<int> slot_;          // global node -> slot in ghost array (-1)
+  std::vector<int> ghost_nodes_;   // nodes needed on this rank, sorted
+  std::vector<double> ghost_u_;    // 3 per ghost node
   Vec ghost_vec_ = nullptr;
   VecScatter scatter_ = nullptr;
-  Mat pattern_ = nullptr;           // preallocated template matrix
+  Mat pattern_ = nullptr;  // preallocated template matrix
 };
 
 }  // namespace morphfem

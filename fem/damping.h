@@ -52,8 +52,7 @@ namespace morphfem {
 
 // Green-Lagrange strain E = 1/2 (F^T F - I) at every point of `table`,
 // F = I + u^T dN/dX (X, u: n x 3 [m]).
-std::vector<Mat3> green_lagrange_at_points(const ShapeTable& table, const Eigen::MatrixXd& X,
-                                           const Eigen::MatrixXd& u);
+std::vector<Mat3> green_lagrange_at_points(const ShapeTable& table, const Eigen::MatrixXd& X, const Eigen::MatrixXd& u);
 
 // Kernel: D = 1/h_eff int [ eta |dev dE|^2 + zeta/2 (tr dE)^2 ] dV of one cell,
 // dE = E(u) - E_star at every point, eta, zeta [Pa s], h_eff = h/kappa [s];

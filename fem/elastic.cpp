@@ -1,9 +1,10 @@
 #include "fem/elastic.h"
-#include "fem/mean_dilatation.h"
 
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+
+#include "fem/mean_dilatation.h"
 
 namespace morphfem {
 
@@ -13,8 +14,7 @@ ElasticTerm::ElasticTerm(const Mesh& mesh, const Partition& partition, int rank,
   for (int c = 0; c < mesh.n_cells(); ++c)
     if (partition.cell_part[c] == rank) {
       if (!materials_.at(mesh.cell_region[c]))
-        throw std::invalid_argument("cell region '" + mesh.regions[mesh.cell_region[c]].name +
-                                    "' has no material");
+        throw std::invalid_argument("cell region '" + mesh.regions[mesh.cell_region[c]].name + "' has no material");
       cells_.push_back(c);
     }
   int degree = quadrature_degree > 0 ? quadrature_degree : (mesh.order == 1 ? 1 : 2);
@@ -100,11 +100,12 @@ ElasticTerm::CellMeasures ElasticTerm::measures(int k, const PieceState& s) cons
 const std::map<std::string, ElasticTermFactory>& elastic_formulations() {
   static const std::map<std::string, ElasticTermFactory> registry{
       {"displacement",
-       [](const Mesh& mesh, const Partition& partition, int rank, std::vector<std::shared_ptr<const Material>> materials,
+       [](const Mesh& mesh, const Partition& partition, int rank,
+          std::vector<std::shared_ptr<const Material>> materials,
           int degree) { return std::make_shared<ElasticTerm>(mesh, partition, rank, std::move(materials), degree); }},
       {"mean_dilatation",
-       [](const Mesh& mesh, const Partition& partition, int rank, std::vector<std::shared_ptr<const Material>> materials,
-          int degree) -> std::shared_ptr<ElasticTerm> {
+       [](const Mesh& mesh, const Partition& partition, int rank,
+          std::vector<std::shared_ptr<const Material>> materials, int degree) -> std::shared_ptr<ElasticTerm> {
          return std::make_shared<MeanDilatationTerm>(mesh, partition, rank, std::move(materials), degree);
        }},
   };

@@ -2,12 +2,12 @@
 
 #include <gmsh.h>
 
-#include "mesh/geometry.h"
-
 #include <map>
 #include <mutex>
 #include <stdexcept>
 #include <string>
+
+#include "mesh/geometry.h"
 
 namespace morphfem {
 
@@ -120,9 +120,7 @@ ShapeTable make_table(int order, const std::vector<QuadraturePoint>& rule, Shape
 }
 }  // namespace
 
-ShapeTable make_tet_table(int order, int degree) {
-  return make_table(order, tet_quadrature(degree), tet_shape);
-}
+ShapeTable make_tet_table(int order, int degree) { return make_table(order, tet_quadrature(degree), tet_shape); }
 ShapeTable make_triangle_table(int order, int degree) {
   return make_table(order, triangle_quadrature(degree), triangle_shape);
 }

@@ -66,8 +66,8 @@ class EndMomentTerm : public EnergyTerm {
   int axis_, across_;
   std::function<double(double)> moment_;
   double moment_now_ = 0.0;
-  double theta0_ = 0.0;   // raw angle of the reference configuration [rad]
-  double branch_ = 0.0;   // theta of the last converged state [rad]
+  double theta0_ = 0.0;  // raw angle of the reference configuration [rad]
+  double branch_ = 0.0;  // theta of the last converged state [rad]
   bool owner_ = false;
 };
 

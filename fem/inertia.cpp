@@ -71,8 +71,9 @@ InertiaTerm::InertiaTerm(const Mesh& mesh, const Partition& partition, int rank,
   for (int c = 0; c < mesh.n_cells(); ++c) {
     if (partition.cell_part[c] != rank) continue;
     const double rho = density.at(mesh.cell_region[c]);
-    if (rho < 0) throw std::invalid_argument("inertia: negative density in region '" +
-                                             mesh.regions[mesh.cell_region[c]].name + "'");
+    if (rho < 0)
+      throw std::invalid_argument("inertia: negative density in region '" + mesh.regions[mesh.cell_region[c]].name +
+                                  "'");
     if (rho == 0) continue;
     for (int a = 0; a < n; ++a) X.row(a) = mesh.X.row(mesh.cells(c, a));
     cells_.push_back(c);
@@ -198,8 +199,7 @@ void InertiaTerm::begin_step(Assembler& assembler, Vec u0, double t0, double t1)
   PetscScalar coeff[4];
   Vec vecs[4];
   int count = 0;
-  if (opt_.scheme == TimeScheme::implicit_euler ||
-      (opt_.scheme == TimeScheme::bdf2 && steps_done_ == 0 && !have_a0_)) {
+  if (opt_.scheme == TimeScheme::implicit_euler || (opt_.scheme == TimeScheme::bdf2 && steps_done_ == 0 && !have_a0_)) {
     // u_pred = u_n + h v_n, c = 1/h^2
     kind_ = StepKind::implicit_euler;
     c_ = 1.0 / (h * h);

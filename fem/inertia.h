@@ -74,16 +74,16 @@ const std::map<std::string, TimeScheme>& time_schemes();
 
 struct InertiaOptions {
   TimeScheme scheme = TimeScheme::newmark;
-  bool lumped = false;          // HRZ-lumped (diagonal) instead of consistent mass
-  double newmark_beta = 0.25;   // (0, 1/2]
-  double newmark_gamma = 0.5;   // [1/2, 1]; > 1/2 adds numerical dissipation
+  bool lumped = false;         // HRZ-lumped (diagonal) instead of consistent mass
+  double newmark_beta = 0.25;  // (0, 1/2]
+  double newmark_gamma = 0.5;  // [1/2, 1]; > 1/2 adds numerical dissipation
   // a_0 from the forces at t_0 (true) or zero (false). Used by newmark and by the
   // trapezoidal first step of bdf2.
   bool equilibrium_initial_acceleration = true;
   // Local truncation error control (see suggested_dt): the largest nodal error
   // estimate allowed per step [m], and the safety factor and growth bounds.
   double error_tolerance = 1e-4;
-  bool adaptive = false;         // let the error estimate reject steps and choose dt (advise_step)
+  bool adaptive = false;  // let the error estimate reject steps and choose dt (advise_step)
   double error_safety = 0.9, error_min_factor = 0.2, error_max_factor = 2.0;
 };
 
@@ -158,7 +158,7 @@ class InertiaTerm : public EnergyTerm {
 
   const Mesh& mesh_;
   std::vector<int> cells_;
-  std::vector<Eigen::MatrixXd> mass_;     // per piece, n x n [kg]
+  std::vector<Eigen::MatrixXd> mass_;  // per piece, n x n [kg]
   InertiaOptions opt_;
   std::function<Eigen::Vector3d(const Eigen::Vector3d&)> v0_;
 
@@ -172,9 +172,9 @@ class InertiaTerm : public EnergyTerm {
   // The current step (set by begin_step).
   StepKind kind_ = StepKind::newmark;
   double h_ = 0.0, c_ = 0.0, w_ = 1.0;
-  double beta_ = 0.25, gamma_ = 0.5;  // of the current step if kind_ == newmark
+  double beta_ = 0.25, gamma_ = 0.5;         // of the current step if kind_ == newmark
   std::vector<Eigen::MatrixXd> pred_piece_;  // per piece, n x 3 [m]
-  bool suppressed_ = false;  // piece() returns 0 (forces for a_0)
+  bool suppressed_ = false;                  // piece() returns 0 (forces for a_0)
 
   double last_error_ = 0.0, suggested_dt_ = std::numeric_limits<double>::infinity();
 };

@@ -12,7 +12,7 @@ Invariants invariants(const Mat3& F) {
   k.J = F.determinant();
   k.C = F.transpose() * F;
   k.I1 = k.C.trace();
-  k.I2 = 0.5 * (k.I1 * k.I1 - k.C.squaredNorm());  // C symmetric: tr C^2 = |C|^2
+  k.I2 = 0.5 * (k.I1 * k.I1 - k.C.squaredNorm());    // C symmetric: tr C^2 = |C|^2
   const double Jm23 = std::cbrt(1.0 / (k.J * k.J));  // J^(-2/3)
   k.Ibar1 = Jm23 * k.I1;
   k.Ibar2 = Jm23 * Jm23 * k.I2;
@@ -49,8 +49,8 @@ void invariant_stress_tangent(const Mat3& F, const Invariants& inv, const Isocho
   const double w_J = (-2.0 / 3.0 * inv.Ibar1 * iso.W1 - 4.0 / 3.0 * inv.Ibar2 * iso.W2) / J + vol.dU;
 
   // Gradients of y = (I1, I2, J) with respect to F.
-  const Mat3 g_I1 = 2.0 * F;                                   // dI1/dF = 2 F
-  const Mat3 g_I2 = 2.0 * (inv.I1 * F - F * inv.C);            // dI2/dF = 2 (I1 F - F C)
+  const Mat3 g_I1 = 2.0 * F;                         // dI1/dF = 2 F
+  const Mat3 g_I2 = 2.0 * (inv.I1 * F - F * inv.C);  // dI2/dF = 2 (I1 F - F C)
   Vec9 g_J;
   det_derivatives(F, J, g_J, A);  // writes d^2J/dF^2 into A when requested
 

@@ -55,8 +55,8 @@ double BodyForceTerm::piece(int k, const PieceState& s, Eigen::VectorXd* g, Eige
   return -f.dot(Eigen::Map<const Eigen::VectorXd>(Eigen::MatrixXd(s.u.transpose()).data(), 3 * n));
 }
 
-SurfaceLoadTerm::SurfaceLoadTerm(const Mesh& mesh, const Partition& partition, int rank,
-                                 const std::vector<int>& faces, VectorField traction)
+SurfaceLoadTerm::SurfaceLoadTerm(const Mesh& mesh, const Partition& partition, int rank, const std::vector<int>& faces,
+                                 VectorField traction)
     : mesh_(mesh), faces_(owned_faces(mesh, partition, rank, faces)), traction_(std::move(traction)) {
   table_ = make_triangle_table(mesh.order, 2 * mesh.order);
   set_time(0.0);

@@ -1,15 +1,15 @@
 // Material registry (the one place where laws are registered by name), the shared
 // parameter helpers, and the silicone presets.
+#include "fem/material.h"
+
 #include <cmath>
 #include <sstream>
 
 #include "core/errors.h"
-#include "fem/material.h"
 
 namespace morphfem {
 
-double positive_parameter(const ParamSet& params, const std::string& key, double hi,
-                          const std::string& what) {
+double positive_parameter(const ParamSet& params, const std::string& key, double hi, const std::string& what) {
   const double v = params.number(key);
   if (!(v > 0.0) || v > hi) {
     std::ostringstream s;
@@ -69,9 +69,8 @@ std::unique_ptr<Material> make_silicone_preset(const ParamSet& params, const Sil
   params.allow_only({"model", "law", "kappa", "nu"});
   const std::string law = params.string("law", "yeoh");
   const double mu0 = law == "neo_hookean" ? fit.neo_mu : 2.0 * fit.yeoh_c1;
-  const double kappa =
-      params.has("kappa") || params.has("nu") ? bulk_modulus_from_params(params, mu0)
-                                              : 2.0 * mu0 * (1.0 + 0.49) / (3.0 * (1.0 - 2.0 * 0.49));
+  const double kappa = params.has("kappa") || params.has("nu") ? bulk_modulus_from_params(params, mu0)
+                                                               : 2.0 * mu0 * (1.0 + 0.49) / (3.0 * (1.0 - 2.0 * 0.49));
   ParamSet law_params(params.context());
   law_params.set("kappa", kappa);
   if (law == "yeoh") {

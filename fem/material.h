@@ -72,7 +72,6 @@ std::unique_ptr<Material> make_ogden(const ParamSet& params);
 // required): kappa = 2 mu0 (1 + nu) / (3 (1 - 2 nu)), mu0 = small-strain shear modulus.
 double bulk_modulus_from_params(const ParamSet& params, double mu0);
 // `key` must be a number in (0, hi]; the message says what the parameter is.
-double positive_parameter(const ParamSet& params, const std::string& key, double hi,
-                          const std::string& what);
+double positive_parameter(const ParamSet& params, const std::string& key, double hi, const std::string& what);
 
 }  // namespace morphfem

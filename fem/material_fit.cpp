@@ -46,8 +46,7 @@ std::vector<std::string> split_fields(const std::string& line) {
 std::optional<double> parse_number(std::string s) {
   s = trim(s);
   if (s.empty()) return std::nullopt;
-  if (s.find(',') != std::string::npos && s.find('.') == std::string::npos)
-    std::replace(s.begin(), s.end(), ',', '.');
+  if (s.find(',') != std::string::npos && s.find('.') == std::string::npos) std::replace(s.begin(), s.end(), ',', '.');
   char* end = nullptr;
   const double v = std::strtod(s.c_str(), &end);
   if (end != s.c_str() + s.size() || !std::isfinite(v)) return std::nullopt;
@@ -155,11 +154,9 @@ TensileTest read_tensile_csv(const std::string& path) {
     if (contains(name, "strain")) first(is_true ? true_strain : eng_strain);
     if (contains(name, "stress")) first(is_true ? true_stress : eng_stress);
     if (contains(name, "load") || contains(name, "force")) first(force);
-    if (contains(name, "extension") || contains(name, "displacement") || contains(name, "crosshead"))
-      first(extension);
+    if (contains(name, "extension") || contains(name, "displacement") || contains(name, "crosshead")) first(extension);
   }
-  auto header_number = [&](const std::vector<std::string>& keys, double (*unit)(const std::string&),
-                           double& value) {
+  auto header_number = [&](const std::vector<std::string>& keys, double (*unit)(const std::string&), double& value) {
     for (const auto& [key, text] : test.header) {
       const std::string k = lower(key);
       for (const auto& want : keys)
@@ -233,7 +230,8 @@ TensileTest read_tensile_csv(const std::string& path) {
     throw InputError(at(header_line),
                      "no usable stress-strain columns: need 'Engineering Strain' and 'Engineering Stress', or "
                      "'Extension' and 'Load' with the specimen length and cross-section in the header block, or "
-                     "'True Strain' and 'True Stress'; found columns " + found);
+                     "'True Strain' and 'True Stress'; found columns " +
+                         found);
   }
 
   std::vector<double> values(used.size());
@@ -242,8 +240,7 @@ TensileTest read_tensile_csv(const std::string& path) {
     if (std::all_of(f.begin(), f.end(), [](const std::string& s) { return s.empty(); })) continue;
     for (size_t k = 0; k < used.size(); ++k) {
       const size_t c = used[k];
-      if (c >= f.size() || f[c].empty())
-        throw InputError(at(i), "missing value in column '" + columns[c] + "'");
+      if (c >= f.size() || f[c].empty()) throw InputError(at(i), "missing value in column '" + columns[c] + "'");
       const auto v = parse_number(f[c]);
       if (!v) throw InputError(at(i), "column '" + columns[c] + "': '" + f[c] + "' is not a number");
       values[k] = *v;
@@ -439,8 +436,7 @@ FitResult fit_ogden(const std::vector<double>& stretch, const std::vector<double
     for (int q = p + 1; q < terms; ++q) pick[q] = pick[q - 1] + 1;
   }
   if (candidates.empty()) throw InputError("", "Ogden fit failed: no finite solution from any start");
-  std::sort(candidates.begin(), candidates.end(),
-            [](const auto& a, const auto& b) { return a.first < b.first; });
+  std::sort(candidates.begin(), candidates.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
   Eigen::VectorXd best;
   double best_cost = std::numeric_limits<double>::infinity();
   bool best_converged = false;
@@ -496,8 +492,7 @@ void select_strain_range(const TensileTest& test, double max_strain, std::vector
 // ---------------------------------------------------------------------------------
 // Command line.
 
-int fit_materials_main(const std::vector<std::string>& args, const std::string& default_data_dir,
-                       std::ostream& out) {
+int fit_materials_main(const std::vector<std::string>& args, const std::string& default_data_dir, std::ostream& out) {
   const std::string usage =
       "usage: morphfem fit-materials [--data-dir DIR] [--max-strain 2.0] [--json] [--curves FILE.csv]";
   std::string data_dir = default_data_dir, curves_file;
@@ -554,8 +549,12 @@ int fit_materials_main(const std::vector<std::string>& args, const std::string& 
         Json c;
         for (size_t k = 0; k < f.names.size(); ++k) c.add(f.names[k], f.values[k]);
         Json j;
-        j.add("model", f.model).add("coefficients", c).add("rms_pa", f.rms).add("small_strain_mu_pa", f.small_strain_mu)
-            .add("stable", f.stable).add("converged", f.converged);
+        j.add("model", f.model)
+            .add("coefficients", c)
+            .add("rms_pa", f.rms)
+            .add("small_strain_mu_pa", f.small_strain_mu)
+            .add("stable", f.stable)
+            .add("converged", f.converged);
         json_fits.push_back(j);
       }
       Json m;

@@ -46,13 +46,13 @@ double uniaxial_stress_yeoh(double lambda, double c1, double c2, double c3);
 double uniaxial_stress_ogden(double lambda, const std::vector<double>& mu, const std::vector<double>& alpha);
 
 struct FitResult {
-  std::string model;                 // "neo_hookean", "yeoh", "ogden"
-  std::vector<std::string> names;    // coefficient names: mu | c1 c2 c3 | mu1 alpha1 ...
-  std::vector<double> values;        // [Pa] for moduli, [-] for exponents
-  double rms = 0;                    // RMS error of P [Pa]
-  double small_strain_mu = 0;        // small-strain shear modulus [Pa]
-  bool stable = true;                // usable as a law (Yeoh: dW/dI1 > 0 up to x = 7; Ogden: mu_p alpha_p > 0)
-  bool converged = true;             // iterative fits only
+  std::string model;               // "neo_hookean", "yeoh", "ogden"
+  std::vector<std::string> names;  // coefficient names: mu | c1 c2 c3 | mu1 alpha1 ...
+  std::vector<double> values;      // [Pa] for moduli, [-] for exponents
+  double rms = 0;                  // RMS error of P [Pa]
+  double small_strain_mu = 0;      // small-strain shear modulus [Pa]
+  bool stable = true;              // usable as a law (Yeoh: dW/dI1 > 0 up to x = 7; Ogden: mu_p alpha_p > 0)
+  bool converged = true;           // iterative fits only
   double value(const std::string& name) const;
 };
 

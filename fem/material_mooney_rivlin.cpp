@@ -16,8 +16,7 @@ namespace {
 
 class MooneyRivlin final : public InvariantMaterial {
  public:
-  MooneyRivlin(double c10, double c01, double kappa)
-      : InvariantMaterial(kappa, true), c10_(c10), c01_(c01) {}
+  MooneyRivlin(double c10, double c01, double kappa) : InvariantMaterial(kappa, true), c10_(c10), c01_(c01) {}
   std::string name() const override { return "mooney_rivlin"; }
   double shear_modulus() const override { return 2.0 * (c10_ + c01_); }
 
@@ -50,8 +49,7 @@ std::unique_ptr<Material> make_mooney_rivlin(const ParamSet& params) {
       throw InputError(params.where(key), s.str());
     }
   }
-  if (!(c10 + c01 > 0.0))
-    throw InputError(params.where("c10"), "c10 + c01 must be > 0 (shear modulus 2 (c10 + c01))");
+  if (!(c10 + c01 > 0.0)) throw InputError(params.where("c10"), "c10 + c01 must be > 0 (shear modulus 2 (c10 + c01))");
   return std::make_unique<MooneyRivlin>(c10, c01, bulk_modulus_from_params(params, 2.0 * (c10 + c01)));
 }
 

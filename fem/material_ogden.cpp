@@ -102,9 +102,9 @@ class Ogden final : public Material {
     W = vol.U;
     Eigen::Vector3d G_eig = Eigen::Vector3d::Zero();  // eigenvalues of sum coef_p g'_p(C)
     Eigen::Matrix3d K = Eigen::Matrix3d::Zero();      // sum coef_p g'_p[c_a, c_b]
-    double d_J = vol.dU;                               // coefficient of dJ/dF in P
-    double dd_JJ = vol.ddU;                            // coefficient of dJ dJ^T in A
-    Eigen::Vector3d v_eig = Eigen::Vector3d::Zero();   // eigenvalues of sum coef s/J g'_p(C)
+    double d_J = vol.dU;                              // coefficient of dJ/dF in P
+    double dd_JJ = vol.ddU;                           // coefficient of dJ dJ^T in A
+    Eigen::Vector3d v_eig = Eigen::Vector3d::Zero();  // eigenvalues of sum coef s/J g'_p(C)
     for (int p = 0; p < n_; ++p) {
       const double a = alpha_[p], s = -a / 3.0, q = 0.5 * a - 1.0;
       const double coef = mu_[p] / a * std::pow(J, s);
@@ -167,12 +167,11 @@ std::unique_ptr<Material> make_ogden(const ParamSet& params) {
   params.allow_only({"model", "mu", "alpha", "kappa", "nu"});
   const std::vector<double> mu = params.list("mu"), alpha = params.list("alpha");
   if (mu.empty() || mu.size() > static_cast<size_t>(kMaxTerms))
-    throw InputError(params.where("mu"), "expected 1 to " + std::to_string(kMaxTerms) +
-                                             " Ogden terms, got " + std::to_string(mu.size()));
+    throw InputError(params.where("mu"),
+                     "expected 1 to " + std::to_string(kMaxTerms) + " Ogden terms, got " + std::to_string(mu.size()));
   if (alpha.size() != mu.size())
-    throw InputError(params.where("alpha"), "alpha has " + std::to_string(alpha.size()) +
-                                                " entries but mu has " + std::to_string(mu.size()) +
-                                                " (one alpha per mu)");
+    throw InputError(params.where("alpha"), "alpha has " + std::to_string(alpha.size()) + " entries but mu has " +
+                                                std::to_string(mu.size()) + " (one alpha per mu)");
   double mu0 = 0;
   for (size_t p = 0; p < mu.size(); ++p) {
     std::ostringstream s;

@@ -20,8 +20,7 @@ namespace {
 
 class Yeoh final : public InvariantMaterial {
  public:
-  Yeoh(double c1, double c2, double c3, double kappa)
-      : InvariantMaterial(kappa, false), c1_(c1), c2_(c2), c3_(c3) {}
+  Yeoh(double c1, double c2, double c3, double kappa) : InvariantMaterial(kappa, false), c1_(c1), c2_(c2), c3_(c3) {}
   std::string name() const override { return "yeoh"; }
   double shear_modulus() const override { return 2.0 * c1_; }
 

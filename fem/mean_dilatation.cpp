@@ -23,9 +23,9 @@ int isochoric_degree(int quadrature_degree) { return quadrature_degree > 0 ? qua
 }  // namespace
 
 MeanDilatationTerm::MeanDilatationTerm(const Mesh& mesh, const Partition& partition, int rank,
-                                       std::vector<std::shared_ptr<const Material>> materials,
-                                       int quadrature_degree)
-    : ElasticTerm(mesh, partition, rank, std::move(materials), mesh.order == 1 ? 1 : isochoric_degree(quadrature_degree)) {
+                                       std::vector<std::shared_ptr<const Material>> materials, int quadrature_degree)
+    : ElasticTerm(mesh, partition, rank, std::move(materials),
+                  mesh.order == 1 ? 1 : isochoric_degree(quadrature_degree)) {
   if (mesh.order != 2)
     throw InputError("solver.formulation",
                      "formulation 'mean_dilatation' needs P2 (order: 2) tetrahedra: on P1 tetrahedra J is "
@@ -81,8 +81,8 @@ double MeanDilatationTerm::piece(int k, const PieceState& s, Eigen::VectorXd* g,
 
   // ---- Volumetric part: V_e U(Theta_e), Theta_e = v_e / V_e.
   double V = 0.0, v = 0.0;
-  Eigen::VectorXd dv;      // dv/du (3n) [m^2]
-  Eigen::MatrixXd d2v;     // d2v/du2 (3n x 3n) [m]
+  Eigen::VectorXd dv;   // dv/du (3n) [m^2]
+  Eigen::MatrixXd d2v;  // d2v/du2 (3n x 3n) [m]
   if (g || H) dv.setZero(3 * n);
   if (H) d2v.setZero(3 * n, 3 * n);
   Eigen::MatrixXd grad_x;  // spatial gradients g_ai = (dN/dX F^-1)_ai  [1/m]

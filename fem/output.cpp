@@ -78,8 +78,7 @@ void check(herr_t status, const std::string& what) {
 // Owns one HDF5 identifier and closes it with the matching H5*close.
 class Handle {
  public:
-  Handle(hid_t id, herr_t (*closer)(hid_t), const std::string& what)
-      : id_(check_id(id, what)), closer_(closer) {}
+  Handle(hid_t id, herr_t (*closer)(hid_t), const std::string& what) : id_(check_id(id, what)), closer_(closer) {}
   ~Handle() {
     if (id_ >= 0) closer_(id_);
   }
@@ -107,8 +106,7 @@ Handle make_lcpl() {
   return lcpl;
 }
 
-void write_string_attribute(hid_t obj, const std::string& name, const std::vector<std::string>& values,
-                            bool scalar) {
+void write_string_attribute(hid_t obj, const std::string& name, const std::vector<std::string>& values, bool scalar) {
   size_t len = 1;
   for (const auto& v : values) len = std::max(len, v.size() + 1);
   std::vector<char> buf(len * values.size(), '\0');
@@ -140,8 +138,8 @@ Handle write_dataset(hid_t file, const std::string& path, hid_t file_type, hid_t
   Handle space(H5Screate_simple(static_cast<int>(dims.size()), dims.data(), nullptr), H5Sclose,
                "H5Screate_simple for " + path);
   Handle lcpl = make_lcpl();
-  Handle dset(H5Dcreate2(file, path.c_str(), file_type, space.get(), lcpl.get(), H5P_DEFAULT, H5P_DEFAULT),
-              H5Dclose, "H5Dcreate2 " + path);
+  Handle dset(H5Dcreate2(file, path.c_str(), file_type, space.get(), lcpl.get(), H5P_DEFAULT, H5P_DEFAULT), H5Dclose,
+              "H5Dcreate2 " + path);
   check(H5Dwrite(dset.get(), mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data), "H5Dwrite " + path);
   return dset;
 }
@@ -159,12 +157,23 @@ std::string xml_escape(const std::string& s) {
   std::string out;
   for (char c : s) {
     switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      case '\'': out += "&apos;"; break;
-      default: out += c;
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      case '\'':
+        out += "&apos;";
+        break;
+      default:
+        out += c;
     }
   }
   return out;
@@ -191,10 +200,14 @@ std::string step_label(int step) {
 
 const char* attribute_type(int components) {
   switch (components) {
-    case 1: return "Scalar";
-    case 3: return "Vector";
-    case 6: return "Tensor6";
-    case 9: return "Tensor";
+    case 1:
+      return "Scalar";
+    case 3:
+      return "Vector";
+    case 6:
+      return "Tensor6";
+    case 9:
+      return "Tensor";
   }
   return "";
 }
@@ -244,8 +257,7 @@ ResultWriter::ResultWriter(const std::string& dir, const std::string& name, cons
   }
   if (mesh.cells.cols() != npc) {
     throw std::runtime_error("ResultWriter: mesh.cells has " + std::to_string(mesh.cells.cols()) +
-                             " columns, expected " + std::to_string(npc) + " for order " +
-                             std::to_string(order_));
+                             " columns, expected " + std::to_string(npc) + " for order " + std::to_string(order_));
   }
   for (Eigen::Index i = 0; i < mesh.X.size(); ++i) {
     if (!std::isfinite(mesh.X.data()[i])) throw std::runtime_error("ResultWriter: non-finite mesh coordinate");
@@ -274,8 +286,7 @@ ResultWriter::ResultWriter(const std::string& dir, const std::string& name, cons
   }
   try {
     std::vector<hsize_t> xdims{static_cast<hsize_t>(n_nodes_), 3};
-    write_dataset(file_, "/mesh/X", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, xdims, mesh.X.data())
-        .close("H5Dclose /mesh/X");
+    write_dataset(file_, "/mesh/X", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, xdims, mesh.X.data()).close("H5Dclose /mesh/X");
     std::vector<hsize_t> cdims{static_cast<hsize_t>(n_cells_), static_cast<hsize_t>(npc)};
     write_dataset(file_, "/mesh/cells", H5T_STD_I32LE, H5T_NATIVE_INT, cdims, mesh.cells.data())
         .close("H5Dclose /mesh/cells");
@@ -336,8 +347,8 @@ void ResultWriter::write_step(double time, const std::vector<Field>& nodal, cons
     }
     const size_t expected = static_cast<size_t>(rows) * f.components;
     if (f.values.size() != expected) {
-      throw std::runtime_error(where + ": " + kind + " field '" + f.name + "' has " +
-                               std::to_string(f.values.size()) + " values, expected " + std::to_string(rows) +
+      throw std::runtime_error(where + ": " + kind + " field '" + f.name + "' has " + std::to_string(f.values.size()) +
+                               " values, expected " + std::to_string(rows) +
                                (std::string(kind) == "nodal" ? " nodes" : " cells") + " x " +
                                std::to_string(f.components) + " = " + std::to_string(expected));
     }
@@ -345,8 +356,7 @@ void ResultWriter::write_step(double time, const std::vector<Field>& nodal, cons
       if (!std::isfinite(f.values[i])) {
         throw std::runtime_error(where + ": " + kind + " field '" + f.name + "' has a non-finite value (" +
                                  number(f.values[i]) + ") at " + (std::string(kind) == "nodal" ? "node " : "cell ") +
-                                 std::to_string(i / f.components) + ", component " +
-                                 std::to_string(i % f.components));
+                                 std::to_string(i / f.components) + ", component " + std::to_string(i % f.components));
       }
     }
   };
@@ -357,8 +367,7 @@ void ResultWriter::write_step(double time, const std::vector<Field>& nodal, cons
   const std::string group = "/steps/" + label;
   {
     Handle lcpl = make_lcpl();
-    Handle g(H5Gcreate2(file_, group.c_str(), lcpl.get(), H5P_DEFAULT, H5P_DEFAULT), H5Gclose,
-             "H5Gcreate2 " + group);
+    Handle g(H5Gcreate2(file_, group.c_str(), lcpl.get(), H5P_DEFAULT, H5P_DEFAULT), H5Gclose, "H5Gcreate2 " + group);
     write_double_attribute(g.get(), "time", time);
     g.close("H5Gclose " + group);
   }
@@ -389,8 +398,7 @@ void ResultWriter::write_step(double time, const std::vector<Field>& nodal, cons
   if (have_regions_ && std::find(names.begin(), names.end(), "region") == names.end()) {
     // Stored once in /mesh; 32-bit integers.
     xml += "        <Attribute Name=\"region\" AttributeType=\"Scalar\" Center=\"Cell\">\n          " +
-           data_item(std::to_string(n_cells_), "Int", 4, h5_name_ + ":/mesh/cell_region") +
-           "\n        </Attribute>\n";
+           data_item(std::to_string(n_cells_), "Int", 4, h5_name_ + ":/mesh/cell_region") + "\n        </Attribute>\n";
   }
   xml += "      </Grid>\n";
 
@@ -422,8 +430,7 @@ void ResultWriter::write_xdmf() const {
          data_item(dims_text(n_nodes_, 3), "Float", 8, h5_name_ + ":/mesh/X") + "\n      </Geometry>\n";
     if (have_regions_) {
       s += "      <Attribute Name=\"region\" AttributeType=\"Scalar\" Center=\"Cell\">\n        " +
-           data_item(std::to_string(n_cells_), "Int", 4, h5_name_ + ":/mesh/cell_region") +
-           "\n      </Attribute>\n";
+           data_item(std::to_string(n_cells_), "Int", 4, h5_name_ + ":/mesh/cell_region") + "\n      </Attribute>\n";
     }
     s += "    </Grid>\n";
   } else {
@@ -479,8 +486,7 @@ void ResultWriter::append_row(const std::string& table, const std::vector<std::s
   hsize_t start[2] = {static_cast<hsize_t>(t.rows), 0}, count[2] = {1, ncols};
   check(H5Sselect_hyperslab(fspace.get(), H5S_SELECT_SET, start, nullptr, count, nullptr), "H5Sselect_hyperslab");
   Handle mspace(H5Screate_simple(2, count, nullptr), H5Sclose, "H5Screate_simple");
-  check(H5Dwrite(d.get(), H5T_NATIVE_DOUBLE, mspace.get(), fspace.get(), H5P_DEFAULT, row.data()),
-        "H5Dwrite " + path);
+  check(H5Dwrite(d.get(), H5T_NATIVE_DOUBLE, mspace.get(), fspace.get(), H5P_DEFAULT, row.data()), "H5Dwrite " + path);
   d.close("H5Dclose " + path);
   check(H5Fflush(file_, H5F_SCOPE_GLOBAL), "H5Fflush " + h5_path_);
   ++t.rows;

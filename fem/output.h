@@ -61,8 +61,7 @@ class ResultWriter {
   // volume per cavity; or energies per step). The first call fixes the columns
   // (stored as attribute "columns"); later calls must pass the same columns.
   // Non-finite values are rejected like in fields.
-  void append_row(const std::string& table, const std::vector<std::string>& columns,
-                  const std::vector<double>& row);
+  void append_row(const std::string& table, const std::vector<std::string>& columns, const std::vector<double>& row);
 
   int steps_written() const { return steps_; }
   // Closes the HDF5 file (idempotent); later writes throw.

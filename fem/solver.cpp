@@ -99,8 +99,8 @@ QuasiStaticSolver::QuasiStaticSolver(Assembler& assembler, std::vector<Dirichlet
     PETSC_CHECK(MatNullSpaceDestroy(&near_null));
     PETSC_CHECK(VecDestroy(&coords));
   } else {
-    throw InputError("solver.linear_solver", "unknown linear solver '" + opt_.linear_solver +
-                                                 "' (allowed: mumps, gamg)");
+    throw InputError("solver.linear_solver",
+                     "unknown linear solver '" + opt_.linear_solver + "' (allowed: mumps, gamg)");
   }
   PETSC_CHECK(SNESSetFromOptions(snes_));
   apply_dirichlet(u_, 0.0);
@@ -124,7 +124,8 @@ void QuasiStaticSolver::set_jacobian() {
     // operator is a shell H + sum c v v^T, preconditioned by (a factorisation of) H.
     if (!J_) {
       const PetscInt n_local = assembler_.owned_dof_end() - assembler_.owned_dof_begin();
-      PETSC_CHECK(MatCreateShell(assembler_.comm(), n_local, n_local, assembler_.n_dofs(), assembler_.n_dofs(), this, &J_));
+      PETSC_CHECK(
+          MatCreateShell(assembler_.comm(), n_local, n_local, assembler_.n_dofs(), assembler_.n_dofs(), this, &J_));
       PETSC_CHECK(MatShellSetOperation(J_, MATOP_MULT, (void (*)(void))shell_mult));
     }
     PETSC_CHECK(SNESSetJacobian(snes_, J_, H_, form_jacobian, this));
@@ -307,7 +308,7 @@ bool QuasiStaticSolver::solve_step(double t_new, int& newton_its, int& linear_it
   double alpha = 1.0;
   for (const auto& term : assembler_.terms()) alpha = std::min(alpha, term->max_step(assembler_, u_, work_));
   PETSC_CHECK(VecAYPX(work_, std::max(alpha, 0.0), u_));  // work = u + alpha (work - u)
-  apply_dirichlet(work_, t_new);  // prescribed values are never scaled
+  apply_dirichlet(work_, t_new);                          // prescribed values are never scaled
   if (!std::isfinite(assembler_.energy(work_))) {
     PETSC_CHECK(VecCopy(u_, work_));
     apply_dirichlet(work_, t_new);
@@ -359,9 +360,9 @@ bool QuasiStaticSolver::solve_step(double t_new, int& newton_its, int& linear_it
     dt_prev_ = dt;
     t_ = t_new;
   } else {
-    why = ierr ? "PETSc error during the solve"
-               : reason == SNES_CONVERGED_ITERATING ? "time-step error estimate above tolerance"
-                                                    : std::string("Newton: ") + SNESConvergedReasons[reason];
+    why = ierr                                 ? "PETSc error during the solve"
+          : reason == SNES_CONVERGED_ITERATING ? "time-step error estimate above tolerance"
+                                               : std::string("Newton: ") + SNESConvergedReasons[reason];
     for (const auto& term : assembler_.terms()) term->set_time(t_);
   }
   VecDestroy(&x);
@@ -414,8 +415,8 @@ RunStats QuasiStaticSolver::run(const std::function<void(const StepReport&)>& on
       dt = 0.5 * (t_new - t_);
       if (dt < opt_.dt_min) {
         std::ostringstream s;
-        s << "step " << stats.steps + 1 << " from t = " << t_ << " s: no convergence with the smallest step dt = "
-          << dt << " s after " << cuts << " cuts (" << why << ")";
+        s << "step " << stats.steps + 1 << " from t = " << t_ << " s: no convergence with the smallest step dt = " << dt
+          << " s after " << cuts << " cuts (" << why << ")";
         stats.failure = s.str();
         break;
       }

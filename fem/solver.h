@@ -29,27 +29,27 @@ struct DirichletCondition {
 };
 
 struct SolverOptions {
-  double t_end = 1.0;         // end of the pseudo-time [s]
-  double dt_initial = 0.1;    // first step [s]
-  double dt_min = 1e-6;       // smallest step before giving up [s]
-  double dt_max = 1.0;        // largest step [s]
-  double grow = 1.5;          // step growth after an easy solve
-  int easy_newton_its = 6;    // "easy": converged in at most this many iterations
+  double t_end = 1.0;       // end of the pseudo-time [s]
+  double dt_initial = 0.1;  // first step [s]
+  double dt_min = 1e-6;     // smallest step before giving up [s]
+  double dt_max = 1.0;      // largest step [s]
+  double grow = 1.5;        // step growth after an easy solve
+  int easy_newton_its = 6;  // "easy": converged in at most this many iterations
   int max_newton_its = 30;
-  int max_outer_updates = 20; // re-solves a step while a term's update_after_solve asks
-  double rtol = 1e-9;         // ||r|| <= rtol ||r_0|| ...
-  double atol_factor = 1e-11; // ... or ||r|| <= atol_factor * (largest ||r_0|| seen)
+  int max_outer_updates = 20;           // re-solves a step while a term's update_after_solve asks
+  double rtol = 1e-9;                   // ||r|| <= rtol ||r_0|| ...
+  double atol_factor = 1e-11;           // ... or ||r|| <= atol_factor * (largest ||r_0|| seen)
   std::string linear_solver = "mumps";  // "mumps" | "gamg"
   std::vector<double> output_times;     // steps land exactly on these times
 };
 
 struct StepReport {
-  int step = 0;        // 1-based converged step count
+  int step = 0;  // 1-based converged step count
   double t = 0, dt = 0;
   int newton_its = 0;  // Newton iterations of this step
   int linear_its = 0;
-  int cuts = 0;        // failed attempts before this step converged
-  double energy = 0;   // total energy [J]
+  int cuts = 0;       // failed attempts before this step converged
+  double energy = 0;  // total energy [J]
 };
 
 struct RunStats {
@@ -84,8 +84,8 @@ class QuasiStaticSolver {
 
  private:
   void apply_dirichlet(Vec u, double t) const;
-  void set_jacobian();          // (re)attach the Hessian (and shell operator) to SNES
-  void refresh_pieces();        // lets terms rebuild state-dependent pieces
+  void set_jacobian();    // (re)attach the Hessian (and shell operator) to SNES
+  void refresh_pieces();  // lets terms rebuild state-dependent pieces
   bool solve_step(double t_new, int& newton_its, int& linear_its, std::string& why);
 
   Assembler& assembler_;
@@ -100,7 +100,8 @@ class QuasiStaticSolver {
   double t_ = 0.0, dt_prev_ = 0.0;
   double fnorm0_ = 0.0, fnorm_scale_ = 0.0;
   double length_scale_ = 1.0;
-  double advised_dt_ = 1e300;  // smallest dt_next advised by the terms for the last attempt  // diagonal of the mesh's bounding box [m]
+  double advised_dt_ =
+      1e300;  // smallest dt_next advised by the terms for the last attempt  // diagonal of the mesh's bounding box [m]
 };
 
 }  // namespace morphfem

@@ -92,13 +92,14 @@ void ChannelMap::check_schedule(const Schedule& s) const {
       uses_on = true;
     } else {
       for (int k = 0; k < s.columns(); ++k) (s.matrix[row][k] ? uses_on : uses_off) = true;
-      if (row >= 8) uses_on = true;  // feet are active while settling and at rest
-      else uses_off = true;          // bladders are deflated at rest
+      if (row >= 8)
+        uses_on = true;  // feet are active while settling and at rest
+      else
+        uses_off = true;  // bladders are deflated at rest
     }
     const ChannelSpec* c = find(ch);
     if (!c) {
-      bool needed = ch == kChannelCore ? lv[ch].inflate_pa != 0
-                                       : (row < 8 ? uses_on : false);
+      bool needed = ch == kChannelCore ? lv[ch].inflate_pa != 0 : (row < 8 ? uses_on : false);
       if (needed)
         throw InputError(source + ": channels",
                          "schedule " + sw + " drives channel " + channel_name(ch) + " but the map has no such channel");
@@ -108,12 +109,12 @@ void ChannelMap::check_schedule(const Schedule& s) const {
       if (p < c->min_pa || p > c->max_pa)
         throw InputError(c->where, std::string("refused before sending anything: schedule ") + sw + " needs " + what +
                                        " pressure " + fmt(p) + " Pa on " + channel_name(ch) +
-                                       ", outside this channel's limits [" + fmt(c->min_pa) + ", " + fmt(c->max_pa) + "] Pa");
+                                       ", outside this channel's limits [" + fmt(c->min_pa) + ", " + fmt(c->max_pa) +
+                                       "] Pa");
     };
     if (uses_on) check(lv[ch].inflate_pa, ch == kChannelCore ? "core" : "inflate");
     if (uses_off && ch != kChannelCore) check(lv[ch].deflate_pa, "deflate");
-    if (0 < c->min_pa || 0 > c->max_pa)
-      throw InputError(c->where, "limits must include 0 Pa (venting to atmosphere)");
+    if (0 < c->min_pa || 0 > c->max_pa) throw InputError(c->where, "limits must include 0 Pa (venting to atmosphere)");
   }
 }
 
@@ -128,13 +129,15 @@ ChannelMap parse_channel_map(const std::string& text, const std::string& source)
   }
   if (!root.IsMap()) throw InputError(source, "a channel map is a YAML mapping");
   r.allow_only(root, "", {"morphfem_channel_map", "devices", "channels"});
-  if (!root["morphfem_channel_map"]) throw InputError(source, "missing required key 'morphfem_channel_map' (version, 1)");
+  if (!root["morphfem_channel_map"])
+    throw InputError(source, "missing required key 'morphfem_channel_map' (version, 1)");
   if (r.number(root["morphfem_channel_map"], "morphfem_channel_map") != 1)
     r.fail(root["morphfem_channel_map"], "morphfem_channel_map", "unsupported version (expected 1)");
   ChannelMap m;
   m.source = source;
   YAML::Node devs = root["devices"];
-  if (!devs || !devs.IsMap() || devs.size() == 0) throw InputError(source + ": devices", "expected at least one device");
+  if (!devs || !devs.IsMap() || devs.size() == 0)
+    throw InputError(source + ": devices", "expected at least one device");
   for (auto it = devs.begin(); it != devs.end(); ++it) {
     DeviceSpec d;
     d.name = it->first.Scalar();
@@ -144,9 +147,12 @@ ChannelMap parse_channel_map(const std::string& text, const std::string& source)
     d.where = r.where(n, key);
     if (!n["protocol"]) r.fail(n, key, "missing 'protocol' (alicat or booth)");
     std::string proto = r.text(n["protocol"], key + ".protocol");
-    if (proto == "alicat") d.protocol = Protocol::alicat;
-    else if (proto == "booth") d.protocol = Protocol::booth;
-    else r.fail(n["protocol"], key + ".protocol", "unknown protocol '" + proto + "' (expected alicat or booth)");
+    if (proto == "alicat")
+      d.protocol = Protocol::alicat;
+    else if (proto == "booth")
+      d.protocol = Protocol::booth;
+    else
+      r.fail(n["protocol"], key + ".protocol", "unknown protocol '" + proto + "' (expected alicat or booth)");
     d.baud = d.protocol == Protocol::alicat ? 19200 : 115200;
     if (n["port"]) d.port = r.text(n["port"], key + ".port");
     if (n["baud"]) {
@@ -174,8 +180,9 @@ ChannelMap parse_channel_map(const std::string& text, const std::string& source)
     if (c.channel < 0) r.fail(it->first, key, "unknown channel '" + name + "' (b1..b8, core, foot_a, foot_b)");
     if (m.find(c.channel)) r.fail(it->first, key, "channel listed twice");
     YAML::Node n = it->second;
-    r.allow_only(n, key, {"device", "address", "inflated_pa", "deflated_pa", "min_pa", "max_pa",
-                          "ramp_limit_pa_per_s", "tolerance_pa"});
+    r.allow_only(
+        n, key,
+        {"device", "address", "inflated_pa", "deflated_pa", "min_pa", "max_pa", "ramp_limit_pa_per_s", "tolerance_pa"});
     c.where = r.where(n, key);
     if (!n["device"]) r.fail(n, key, "missing 'device'");
     c.device = r.text(n["device"], key + ".device");
@@ -221,7 +228,8 @@ ChannelMap parse_channel_map(const std::string& text, const std::string& source)
     within(c.deflated_pa, "deflated_pa");
     if (n["ramp_limit_pa_per_s"]) {
       c.ramp_limit_pa_per_s = r.number(n["ramp_limit_pa_per_s"], key + ".ramp_limit_pa_per_s");
-      if (c.ramp_limit_pa_per_s <= 0) r.fail(n["ramp_limit_pa_per_s"], key + ".ramp_limit_pa_per_s", "must be positive");
+      if (c.ramp_limit_pa_per_s <= 0)
+        r.fail(n["ramp_limit_pa_per_s"], key + ".ramp_limit_pa_per_s", "must be positive");
     }
     if (n["tolerance_pa"]) {
       c.tolerance_pa = r.number(n["tolerance_pa"], key + ".tolerance_pa");

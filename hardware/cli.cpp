@@ -79,41 +79,63 @@ int hardware_main(const std::vector<std::string>& args) {
           val = v.substr(eq + 1);
         }
       };
-      if (a == "--map") map_path = value();
+      if (a == "--map")
+        map_path = value();
       else if (a == "--port") {
         std::string k, v;
         split(value(), k, v);
         po.ports[k] = v;
       } else if (a == "--mode") {
         std::string m = value();
-        if (m == "fixed") po.mode = PlayerOptions::Mode::fixed;
-        else if (m == "settle") po.mode = PlayerOptions::Mode::settle;
-        else if (m == "step") po.mode = PlayerOptions::Mode::step;
-        else throw InputError("--mode", "expected fixed, settle or step, got '" + m + "'");
+        if (m == "fixed")
+          po.mode = PlayerOptions::Mode::fixed;
+        else if (m == "settle")
+          po.mode = PlayerOptions::Mode::settle;
+        else if (m == "step")
+          po.mode = PlayerOptions::Mode::step;
+        else
+          throw InputError("--mode", "expected fixed, settle or step, got '" + m + "'");
       } else if (a == "--time-scale") {
         po.time_scale = ec.time_scale = number_arg(a, value());
         if (!(po.time_scale > 0)) throw InputError(a, "must be positive");
-      } else if (a == "--tick-ms") po.tick_s = number_arg(a, value()) / 1000;
-      else if (a == "--reply-timeout-ms") po.reply_timeout_s = number_arg(a, value()) / 1000;
-      else if (a == "--reconnect-s") po.reconnect_s = number_arg(a, value());
-      else if (a == "--settle-timeout-s") po.settle_timeout_s = number_arg(a, value());
-      else if (a == "--tracking-fault-pa") po.tracking_fault_pa = number_arg(a, value());
-      else if (a == "--tracking-fault-s") po.tracking_fault_s = number_arg(a, value());
-      else if (a == "--min-hold-s") po.min_hold_s = number_arg(a, value());
-      else if (a == "--log") po.log_path = value();
-      else if (a == "--dry-run") po.dry_run = true;
-      else if (a == "--no-display") po.display = false;
+      } else if (a == "--tick-ms")
+        po.tick_s = number_arg(a, value()) / 1000;
+      else if (a == "--reply-timeout-ms")
+        po.reply_timeout_s = number_arg(a, value()) / 1000;
+      else if (a == "--reconnect-s")
+        po.reconnect_s = number_arg(a, value());
+      else if (a == "--settle-timeout-s")
+        po.settle_timeout_s = number_arg(a, value());
+      else if (a == "--tracking-fault-pa")
+        po.tracking_fault_pa = number_arg(a, value());
+      else if (a == "--tracking-fault-s")
+        po.tracking_fault_s = number_arg(a, value());
+      else if (a == "--min-hold-s")
+        po.min_hold_s = number_arg(a, value());
+      else if (a == "--log")
+        po.log_path = value();
+      else if (a == "--dry-run")
+        po.dry_run = true;
+      else if (a == "--no-display")
+        po.display = false;
       else if (a == "--link") {
         std::string k, v;
         split(value(), k, v);
         ec.links[k] = v;
-      } else if (a == "--seed") ec.seed = static_cast<std::uint64_t>(number_arg(a, value()));
-      else if (a == "--noise-pa") ec.noise_pa = number_arg(a, value());
-      else if (a == "--rupture-pa") ec.rupture_pa = number_arg(a, value());
-      else if (a == "--fault") ec.faults.push_back(parse_fault(value()));
-      else if (a == "--duration-s") duration_s = number_arg(a, value());
-      else if (!a.empty() && a[0] == '-') throw InputError(a, "unknown option");
-      else pos.push_back(a);
+      } else if (a == "--seed")
+        ec.seed = static_cast<std::uint64_t>(number_arg(a, value()));
+      else if (a == "--noise-pa")
+        ec.noise_pa = number_arg(a, value());
+      else if (a == "--rupture-pa")
+        ec.rupture_pa = number_arg(a, value());
+      else if (a == "--fault")
+        ec.faults.push_back(parse_fault(value()));
+      else if (a == "--duration-s")
+        duration_s = number_arg(a, value());
+      else if (!a.empty() && a[0] == '-')
+        throw InputError(a, "unknown option");
+      else
+        pos.push_back(a);
     }
 
     if (cmd == "check") {
@@ -146,7 +168,8 @@ int hardware_main(const std::vector<std::string>& args) {
       for (auto& [dev, path] : paths) std::cout << dev << " " << path << "\n";
       std::cout << std::flush;
       g_emulate_stop = false;
-      struct sigaction sa {}, old_int {}, old_term {};
+      struct sigaction sa {
+      }, old_int{}, old_term{};
       sa.sa_handler = on_emulate_signal;
       sigemptyset(&sa.sa_mask);
       sigaction(SIGINT, &sa, &old_int);
@@ -154,8 +177,7 @@ int hardware_main(const std::vector<std::string>& args) {
       auto t0 = std::chrono::steady_clock::now();
       while (!g_emulate_stop) {
         std::this_thread::sleep_for(std::chrono::milliseconds(20));
-        if (duration_s > 0 &&
-            std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() > duration_s)
+        if (duration_s > 0 && std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() > duration_s)
           break;
       }
       emu.stop();

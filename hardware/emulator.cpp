@@ -20,9 +20,7 @@
 namespace morphfem::hw {
 
 namespace {
-double wall_s() {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
+double wall_s() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
 }  // namespace
 
 struct Emulator::Chan {
@@ -64,13 +62,14 @@ EmulatorFault parse_fault(const std::string& spec, const std::string& where) {
     rest = rest.substr(0, colon);
   }
   static const std::map<std::string, EmulatorFault::Kind> kinds = {
-      {"garble", EmulatorFault::garble}, {"drop", EmulatorFault::drop},     {"silence", EmulatorFault::silence},
-      {"delay", EmulatorFault::delay},   {"disconnect", EmulatorFault::disconnect},
-      {"stuck", EmulatorFault::stuck},   {"rupture", EmulatorFault::rupture}};
+      {"garble", EmulatorFault::garble},         {"drop", EmulatorFault::drop},
+      {"silence", EmulatorFault::silence},       {"delay", EmulatorFault::delay},
+      {"disconnect", EmulatorFault::disconnect}, {"stuck", EmulatorFault::stuck},
+      {"rupture", EmulatorFault::rupture}};
   auto k = kinds.find(kind);
   if (k == kinds.end())
-    throw InputError(where, "unknown fault kind '" + kind +
-                                "' (garble, drop, silence, delay, disconnect, stuck, rupture)");
+    throw InputError(where,
+                     "unknown fault kind '" + kind + "' (garble, drop, silence, delay, disconnect, stuck, rupture)");
   f.kind = k->second;
   auto num = [&](const std::string& s, const char* what) {
     char* end = nullptr;
@@ -82,10 +81,18 @@ EmulatorFault parse_fault(const std::string& spec, const std::string& where) {
   f.at_s = num(rest, "time");
   switch (f.kind) {
     case EmulatorFault::garble:
-    case EmulatorFault::drop: f.arg = arg.empty() ? 1 : num(arg, "count"); break;
-    case EmulatorFault::silence: f.arg = arg.empty() ? -1 : num(arg, "duration"); break;
-    case EmulatorFault::delay: f.arg = num(arg, "delay in ms"); break;
-    case EmulatorFault::disconnect: f.arg = arg.empty() ? -1 : num(arg, "duration"); break;
+    case EmulatorFault::drop:
+      f.arg = arg.empty() ? 1 : num(arg, "count");
+      break;
+    case EmulatorFault::silence:
+      f.arg = arg.empty() ? -1 : num(arg, "duration");
+      break;
+    case EmulatorFault::delay:
+      f.arg = num(arg, "delay in ms");
+      break;
+    case EmulatorFault::disconnect:
+      f.arg = arg.empty() ? -1 : num(arg, "duration");
+      break;
     case EmulatorFault::stuck:
     case EmulatorFault::rupture:
       f.channel = channel_index(arg);
@@ -256,8 +263,10 @@ void Emulator::send(Device& d, std::vector<std::uint8_t> bytes) {
     --garble_left_;
     if (d.spec.protocol == Protocol::alicat) {
       // Corrupt the first number so that no parser can take it for a value.
-      if (bytes.size() > 3) bytes[3] = '#';
-      else bytes.insert(bytes.begin(), '#');
+      if (bytes.size() > 3)
+        bytes[3] = '#';
+      else
+        bytes.insert(bytes.begin(), '#');
     } else {
       bytes.back() ^= 0x5a;  // CRC no longer matches
     }
@@ -303,8 +312,10 @@ void Emulator::handle_alicat(Device& d, const std::string& raw) {
   f.id = id;
   f.pressure_pa = measure(*c, Protocol::alicat);
   f.setpoint_pa = c->sp;
-  if (c->last_u < -0.01) f.status.push_back("EXH");
-  else if (c->last_u == 0) f.status.push_back("HLD");
+  if (c->last_u < -0.01)
+    f.status.push_back("EXH");
+  else if (c->last_u == 0)
+    f.status.push_back("HLD");
   if (c->p > cfg_.supply_pa * 0.99) f.status.push_back("OPR");
   std::string s = format_alicat_frame(f);
   send(d, std::vector<std::uint8_t>(s.begin(), s.end()));
@@ -331,9 +342,12 @@ void Emulator::handle_booth(Device& d, const booth::Frame& f) {
       c->sp = sensor.pressure(booth::get_counts(c->regs[booth::kRegSetpointHi], c->regs[booth::kRegSetpointLo]));
       c->half_band_pa = c->regs[booth::kRegHalfBand] * sensor.resolution_pa();
       std::uint8_t st = c->regs[booth::kRegDesiredState];
-      if (st == booth::kStateVent) c->mode = 0;
-      else if (c->regs[booth::kRegMode] == 0 || st == booth::kStateHold) c->mode = 2;
-      else c->mode = 1;
+      if (st == booth::kStateVent)
+        c->mode = 0;
+      else if (c->regs[booth::kRegMode] == 0 || st == booth::kStateHold)
+        c->mode = 2;
+      else
+        c->mode = 1;
     }
     send(d, booth::reply_frame(booth::kStatusAck, f.addr, {}));
   } else if (f.cmd_or_status == booth::kCmdRead) {
@@ -354,8 +368,8 @@ void Emulator::handle_booth(Device& d, const booth::Frame& f) {
     }
     booth::put_counts(sensor.counts(measure(*c, Protocol::booth)), c->regs[booth::kRegPressureHi],
                       c->regs[booth::kRegPressureLo]);
-    send(d, booth::reply_frame(booth::kStatusAck, f.addr,
-                               std::vector<std::uint8_t>(c->regs + reg, c->regs + reg + len)));
+    send(d,
+         booth::reply_frame(booth::kStatusAck, f.addr, std::vector<std::uint8_t>(c->regs + reg, c->regs + reg + len)));
   } else {
     send(d, booth::reply_frame(booth::kStatusBadCommand, f.addr, {}));
   }
@@ -387,8 +401,10 @@ void Emulator::serve(Device& d, double now_wall) {
       if (res == booth::Parse::need_more) break;
       if (t_first_request_ < 0) t_first_request_ = t_emu_;
       ++requests_;
-      if (res == booth::Parse::ok) handle_booth(d, f);
-      else if (used > 1 && d.rx.size() >= 3) send(d, booth::reply_frame(booth::kStatusBadCrc, d.rx[2], {}));
+      if (res == booth::Parse::ok)
+        handle_booth(d, f);
+      else if (used > 1 && d.rx.size() >= 3)
+        send(d, booth::reply_frame(booth::kStatusBadCrc, d.rx[2], {}));
       d.rx.erase(d.rx.begin(), d.rx.begin() + std::max<std::size_t>(1, used));
     } else {
       auto cr = std::find(d.rx.begin(), d.rx.end(), '\r');
@@ -412,10 +428,18 @@ void Emulator::fire_faults(double now_wall) {
     if (f.fired || rel < f.at_s) continue;
     f.fired = true;
     switch (f.kind) {
-      case EmulatorFault::garble: garble_left_ += static_cast<int>(f.arg); break;
-      case EmulatorFault::drop: drop_left_ += static_cast<int>(f.arg); break;
-      case EmulatorFault::silence: silence_until_ = f.arg < 0 ? -2 : t_emu_ + f.arg; break;
-      case EmulatorFault::delay: delay_ms_ = f.arg; break;
+      case EmulatorFault::garble:
+        garble_left_ += static_cast<int>(f.arg);
+        break;
+      case EmulatorFault::drop:
+        drop_left_ += static_cast<int>(f.arg);
+        break;
+      case EmulatorFault::silence:
+        silence_until_ = f.arg < 0 ? -2 : t_emu_ + f.arg;
+        break;
+      case EmulatorFault::delay:
+        delay_ms_ = f.arg;
+        break;
       case EmulatorFault::disconnect:
         for (auto& d : devices_) {
           close_pty(*d);
@@ -442,8 +466,10 @@ void Emulator::loop() {
     std::vector<pollfd> fds;
     for (auto& d : devices_)
       if (!d->down) fds.push_back({d->master, POLLIN, 0});
-    if (fds.empty()) std::this_thread::sleep_for(std::chrono::milliseconds(2));
-    else ::poll(fds.data(), fds.size(), 2);
+    if (fds.empty())
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    else
+      ::poll(fds.data(), fds.size(), 2);
     std::lock_guard<std::mutex> lock(mu_);
     double now = wall_s();
     double dt = (now - last_wall_) * cfg_.time_scale;

@@ -45,8 +45,8 @@ namespace morphfem::hw {
 struct EmulatorFault {
   enum Kind { garble, drop, silence, delay, disconnect, stuck, rupture } kind = garble;
   double at_s = 0;
-  double arg = 0;   // count, seconds or milliseconds depending on kind
-  int channel = -1; // stuck, rupture
+  double arg = 0;    // count, seconds or milliseconds depending on kind
+  int channel = -1;  // stuck, rupture
   bool fired = false;
 };
 
@@ -63,8 +63,8 @@ struct EmulatorConfig {
   double vent_tau_s = 0.06;
   double leak_tau_s = 0.004;
   double noise_pa = 60;
-  double rupture_pa = 60000;       // bladders (b1..b8)
-  double rupture_core_pa = 120000; // core and feet
+  double rupture_pa = 60000;        // bladders (b1..b8)
+  double rupture_core_pa = 120000;  // core and feet
   std::vector<EmulatorFault> faults;
   // Device name -> path of a symlink to its pty (kept across reconnections).
   std::map<std::string, std::string> links;

@@ -28,9 +28,7 @@ std::atomic<int> g_stop_signal{0};
 
 extern "C" void on_stop_signal(int sig) { g_stop_signal.store(sig); }
 
-double wall_s() {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
+double wall_s() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
@@ -56,8 +54,8 @@ struct Regulator {
   double sent = kNaN;  // last setpoint acknowledged by the device
 
   std::string label() const {
-    std::string a = dev.protocol == Protocol::alicat ? std::string(1, char(spec.address))
-                                                     : std::to_string(spec.address);
+    std::string a =
+        dev.protocol == Protocol::alicat ? std::string(1, char(spec.address)) : std::to_string(spec.address);
     return channel_name(spec.channel) + " (" + dev.name + " " + protocol_name(dev.protocol) + " address " + a + ")";
   }
 
@@ -101,9 +99,8 @@ struct Regulator {
       std::uint8_t tmp[64];
       std::size_t n = left > 0 ? p.read_some(tmp, sizeof tmp, left) : 0;
       if (n == 0)
-        throw TimeoutError("no complete reply from " + label() + " within " +
-                           std::to_string(int(timeout * 1000)) + " ms" +
-                           (buf.empty() ? " (silence)" : " (partial frame [" + hex_bytes(buf) + "])"));
+        throw TimeoutError("no complete reply from " + label() + " within " + std::to_string(int(timeout * 1000)) +
+                           " ms" + (buf.empty() ? " (silence)" : " (partial frame [" + hex_bytes(buf) + "])"));
       buf.insert(buf.end(), tmp, tmp + n);
       if (buf.size() > 64) throw DeviceError("garbled reply from " + label() + ": overlong frame");
     }
@@ -131,8 +128,10 @@ struct Regulator {
 
   void init(double timeout) {
     sent = kNaN;
-    if (dev.protocol == Protocol::alicat) alicat_exchange(alicat_poll(char(spec.address)), timeout);
-    else booth_exchange(booth_init_request(), timeout);
+    if (dev.protocol == Protocol::alicat)
+      alicat_exchange(alicat_poll(char(spec.address)), timeout);
+    else
+      booth_exchange(booth_init_request(), timeout);
   }
 
   // Sends a setpoint; returns the measured pressure.
@@ -221,7 +220,8 @@ class CsvLog {
 
 struct SignalGuard {
   bool active;
-  struct sigaction old_int {}, old_term {};
+  struct sigaction old_int {
+  }, old_term{};
   explicit SignalGuard(bool on) : active(on) {
     g_stop_signal = 0;
     if (!active) return;
@@ -262,8 +262,10 @@ int play(const Schedule& schedule, const ChannelMap& map, const PlayerOptions& o
     r.spec = *c;
     r.dev = *map.device(c->device);
     auto ov = opt.ports.find(r.dev.name);
-    if (ov != opt.ports.end()) r.dev.port = ov->second;
-    else if (opt.ports.count("")) r.dev.port = opt.ports.at("");
+    if (ov != opt.ports.end())
+      r.dev.port = ov->second;
+    else if (opt.ports.count(""))
+      r.dev.port = opt.ports.at("");
     if (r.dev.port.empty() && !opt.dry_run)
       throw InputError(r.dev.where, "device " + r.dev.name + " has no port (give one in the map or with --port)");
     Line* line = nullptr;
@@ -295,8 +297,8 @@ int play(const Schedule& schedule, const ChannelMap& map, const PlayerOptions& o
   log.header();
 
   const int K = schedule.total_columns();
-  int k = -1;        // current column; -1 = settling before column 0
-  double tau = 0;    // schedule time spent in the current column
+  int k = -1;      // current column; -1 = settling before column 0
+  double tau = 0;  // schedule time spent in the current column
   double t = -schedule.settle_s;
   const double tol_default = 2000;
 
@@ -392,10 +394,11 @@ int play(const Schedule& schedule, const ChannelMap& map, const PlayerOptions& o
     double remaining = dt;
     while (remaining > 0 && !finished) {
       double len;
-      if (k < 0) len = (opt.mode == Mode::fixed) ? schedule.settle_s : std::numeric_limits<double>::infinity();
-      else len = (opt.mode == Mode::fixed) ? schedule.column_s : std::numeric_limits<double>::infinity();
-      if (k < 0 && opt.mode != Mode::fixed && schedule.settle_s > 0)
-        len = std::numeric_limits<double>::infinity();
+      if (k < 0)
+        len = (opt.mode == Mode::fixed) ? schedule.settle_s : std::numeric_limits<double>::infinity();
+      else
+        len = (opt.mode == Mode::fixed) ? schedule.column_s : std::numeric_limits<double>::infinity();
+      if (k < 0 && opt.mode != Mode::fixed && schedule.settle_s > 0) len = std::numeric_limits<double>::infinity();
       double step = std::min(remaining, std::max(0.0, len - tau));
       for (std::size_t i = 0; i < regs.size(); ++i) {
         double rise, fall;
@@ -408,8 +411,10 @@ int play(const Schedule& schedule, const ChannelMap& map, const PlayerOptions& o
       if (tau >= len - 1e-12) {
         ++k;
         tau = 0;
-        if (k >= K) finished = true;
-        else if (opt.mode == Mode::fixed || k == 0) log.event(t, k, "event", "column " + std::to_string(k + 1));
+        if (k >= K)
+          finished = true;
+        else if (opt.mode == Mode::fixed || k == 0)
+          log.event(t, k, "event", "column " + std::to_string(k + 1));
       } else {
         break;
       }
@@ -437,8 +442,10 @@ int play(const Schedule& schedule, const ChannelMap& map, const PlayerOptions& o
         for (std::size_t i = 0; i < regs.size(); ++i) {
           for (int attempt = 0;; ++attempt) {
             try {
-              if (!(std::abs(cmd[i] - regs[i].sent) <= 0.5)) meas[i] = regs[i].command(cmd[i], io_timeout);
-              else meas[i] = regs[i].poll(io_timeout);
+              if (!(std::abs(cmd[i] - regs[i].sent) <= 0.5))
+                meas[i] = regs[i].command(cmd[i], io_timeout);
+              else
+                meas[i] = regs[i].poll(io_timeout);
               break;
             } catch (const DisconnectedError& e) {
               if (attempt > 0 || !reconnect(*regs[i].line, e.what()))
@@ -479,8 +486,8 @@ int play(const Schedule& schedule, const ChannelMap& map, const PlayerOptions& o
           off_since[i] = kNaN;
         }
         double tol = regs[i].spec.tolerance_pa > 0 ? regs[i].spec.tolerance_pa : tol_default;
-        double target = std::clamp(schedule.target_pa(regs[i].spec.channel, k, levels), regs[i].spec.min_pa,
-                                   regs[i].spec.max_pa);
+        double target =
+            std::clamp(schedule.target_pa(regs[i].spec.channel, k, levels), regs[i].spec.min_pa, regs[i].spec.max_pa);
         if (!(e <= tol) || std::abs(cmd[i] - target) > 0.5) settled = false;
       }
     }
@@ -528,8 +535,10 @@ int play(const Schedule& schedule, const ChannelMap& map, const PlayerOptions& o
   if (opt.display) err << "\n";
 
   // ---- 4. Vent every channel, whatever happened. --------------------------------
-  if (code != kExitOk) log.event(t, k, "fault", fault);
-  else log.event(t, k, "event", stop_reason.empty() ? "end of schedule" : stop_reason);
+  if (code != kExitOk)
+    log.event(t, k, "fault", fault);
+  else
+    log.event(t, k, "event", stop_reason.empty() ? "end of schedule" : stop_reason);
   std::vector<std::string> not_vented;
   if (opt.dry_run) {
     for (auto& r : regs)

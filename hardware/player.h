@@ -23,31 +23,31 @@ namespace morphfem::hw {
 
 // Exit codes of play() and `morphfem hw play`.
 constexpr int kExitOk = 0;
-constexpr int kExitInput = 2;        // refused before anything was sent
-constexpr int kExitFault = 3;        // device fault; all channels vented
-constexpr int kExitVentFailed = 4;   // fault and at least one channel could not be vented
+constexpr int kExitInput = 2;       // refused before anything was sent
+constexpr int kExitFault = 3;       // device fault; all channels vented
+constexpr int kExitVentFailed = 4;  // fault and at least one channel could not be vented
 constexpr int kExitSigint = 130;
 constexpr int kExitSigterm = 143;
 
 struct PlayerOptions {
   enum class Mode { fixed, settle, step } mode = Mode::fixed;
-  double time_scale = 1;          // schedule seconds per wall second (tests: 10)
-  double tick_s = 0.02;           // wall seconds between control ticks
-  double reply_timeout_s = 0.3;   // wall seconds to wait for a reply
-  double reconnect_s = 2.0;       // wall seconds to wait for a vanished port while playing
-  double vent_reconnect_s = 5.0;  // ... and before venting after a fault
-  double settle_timeout_s = 30;   // settle mode: schedule seconds a column may wait
-  double min_hold_s = 0;          // settle mode: minimum column time
-  double tracking_fault_pa = 15000;  // |measured - commanded| that counts as a fault ...
-  double tracking_fault_s = 1.0;     // ... when it lasts this long (schedule seconds)
-  bool dry_run = false;           // print the command stream, open no port
-  bool display = false;           // live commanded/measured line on `err`
-  std::string log_path;           // CSV log ("" = none)
+  double time_scale = 1;                     // schedule seconds per wall second (tests: 10)
+  double tick_s = 0.02;                      // wall seconds between control ticks
+  double reply_timeout_s = 0.3;              // wall seconds to wait for a reply
+  double reconnect_s = 2.0;                  // wall seconds to wait for a vanished port while playing
+  double vent_reconnect_s = 5.0;             // ... and before venting after a fault
+  double settle_timeout_s = 30;              // settle mode: schedule seconds a column may wait
+  double min_hold_s = 0;                     // settle mode: minimum column time
+  double tracking_fault_pa = 15000;          // |measured - commanded| that counts as a fault ...
+  double tracking_fault_s = 1.0;             // ... when it lasts this long (schedule seconds)
+  bool dry_run = false;                      // print the command stream, open no port
+  bool display = false;                      // live commanded/measured line on `err`
+  std::string log_path;                      // CSV log ("" = none)
   std::map<std::string, std::string> ports;  // device name -> port path override
-  int step_fd = 0;                // step mode: a byte (Enter) advances, 'q' stops
-  bool handle_signals = true;     // install SIGINT/SIGTERM handlers during play
-  std::ostream* out = nullptr;    // dry-run command stream, summary (default std::cout)
-  std::ostream* err = nullptr;    // messages, live display (default std::cerr)
+  int step_fd = 0;                           // step mode: a byte (Enter) advances, 'q' stops
+  bool handle_signals = true;                // install SIGINT/SIGTERM handlers during play
+  std::ostream* out = nullptr;               // dry-run command stream, summary (default std::cout)
+  std::ostream* err = nullptr;               // messages, live display (default std::cerr)
 };
 
 // Plays the schedule; returns one of the exit codes above. Throws InputError

@@ -31,9 +31,12 @@ bool parse_decimal(std::string_view tok, double& out) {
   bool digits = false, dot = false;
   for (std::size_t j = i; j < tok.size(); ++j) {
     char c = tok[j];
-    if (c >= '0' && c <= '9') digits = true;
-    else if (c == '.' && !dot) dot = true;
-    else return false;
+    if (c >= '0' && c <= '9')
+      digits = true;
+    else if (c == '.' && !dot)
+      dot = true;
+    else
+      return false;
   }
   if (!digits) return false;
   std::string s(tok);
@@ -102,7 +105,8 @@ std::uint8_t crc8(const std::uint8_t* data, std::size_t n) {
   std::uint8_t crc = 0;
   for (std::size_t i = 0; i < n; ++i) {
     crc ^= data[i];
-    for (int b = 0; b < 8; ++b) crc = (crc & 0x80) ? static_cast<std::uint8_t>((crc << 1) ^ 0x07) : static_cast<std::uint8_t>(crc << 1);
+    for (int b = 0; b < 8; ++b)
+      crc = (crc & 0x80) ? static_cast<std::uint8_t>((crc << 1) ^ 0x07) : static_cast<std::uint8_t>(crc << 1);
   }
   return crc;
 }
@@ -114,9 +118,7 @@ int Sensor::counts(double pa) const {
   return static_cast<int>(std::lround(x));
 }
 
-double Sensor::pressure(int counts) const {
-  return min_pa + (counts / 1023.0 - 0.1) / 0.8 * (max_pa - min_pa);
-}
+double Sensor::pressure(int counts) const { return min_pa + (counts / 1023.0 - 0.1) / 0.8 * (max_pa - min_pa); }
 
 void put_counts(int counts, std::uint8_t& hi, std::uint8_t& lo) {
   unsigned v = static_cast<unsigned>(counts & 0x3ff) << 6;
@@ -236,12 +238,15 @@ std::string escape_ascii(std::string_view in) {
   std::string s;
   char buf[8];
   for (unsigned char c : in) {
-    if (c == '\r') s += "\\r";
-    else if (c == '\n') s += "\\n";
+    if (c == '\r')
+      s += "\\r";
+    else if (c == '\n')
+      s += "\\n";
     else if (c < 0x20 || c > 0x7e) {
       std::snprintf(buf, sizeof buf, "\\x%02X", c);
       s += buf;
-    } else s += static_cast<char>(c);
+    } else
+      s += static_cast<char>(c);
   }
   return s;
 }

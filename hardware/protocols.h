@@ -84,8 +84,7 @@ constexpr int kRegSetpointHi = 16, kRegSetpointLo = 17, kRegDesiredState = 18;
 constexpr int kRegPressureHi = 19, kRegPressureLo = 20, kRegHalfBand = 21;
 constexpr int kRegMode = 22, kRegOnlyPressure = 23;
 constexpr std::uint8_t kStateVent = 0, kStateRegulate = 1, kStateHold = 2;
-constexpr std::uint8_t kStatusAck = 0, kStatusNack = 1, kStatusBadCrc = 2, kStatusBadRange = 3,
-                       kStatusBadCommand = 4;
+constexpr std::uint8_t kStatusAck = 0, kStatusNack = 1, kStatusBadCrc = 2, kStatusBadRange = 3, kStatusBadCommand = 4;
 
 std::uint8_t crc8(const std::uint8_t* data, std::size_t n);
 

@@ -13,22 +13,29 @@
 namespace morphfem::hw {
 
 namespace {
-double now_s() {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
+double now_s() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
 }  // namespace
 
 unsigned baud_constant(int baud) {
   switch (baud) {
-    case 9600: return B9600;
-    case 19200: return B19200;
-    case 38400: return B38400;
-    case 57600: return B57600;
-    case 115200: return B115200;
-    case 230400: return B230400;
-    case 460800: return B460800;
-    case 921600: return B921600;
-    default: throw std::invalid_argument("unsupported baud rate " + std::to_string(baud));
+    case 9600:
+      return B9600;
+    case 19200:
+      return B19200;
+    case 38400:
+      return B38400;
+    case 57600:
+      return B57600;
+    case 115200:
+      return B115200;
+    case 230400:
+      return B230400;
+    case 460800:
+      return B460800;
+    case 921600:
+      return B921600;
+    default:
+      throw std::invalid_argument("unsupported baud rate " + std::to_string(baud));
   }
 }
 
@@ -86,8 +93,7 @@ void SerialPort::write_all(const std::uint8_t* data, std::size_t n, double timeo
     if (left <= 0) throw TimeoutError("write to " + path_ + " timed out");
     pollfd p{fd_, POLLOUT, 0};
     int r = ::poll(&p, 1, static_cast<int>(left * 1000) + 1);
-    if (r > 0 && (p.revents & (POLLHUP | POLLERR | POLLNVAL)))
-      throw DisconnectedError(path_ + " hung up");
+    if (r > 0 && (p.revents & (POLLHUP | POLLERR | POLLNVAL))) throw DisconnectedError(path_ + " hung up");
   }
 }
 
@@ -130,8 +136,8 @@ std::string SerialPort::read_line(char terminator, double timeout_s, std::size_t
     if (static_cast<char>(c) == terminator) return line;
   }
   if (line.size() >= max_len) return line;  // caller rejects it as malformed
-  throw TimeoutError("no complete reply within " + std::to_string(static_cast<int>(timeout_s * 1000)) +
-                     " ms on " + path_ + (line.empty() ? " (silence)" : " (got a partial frame)"));
+  throw TimeoutError("no complete reply within " + std::to_string(static_cast<int>(timeout_s * 1000)) + " ms on " +
+                     path_ + (line.empty() ? " (silence)" : " (got a partial frame)"));
 }
 
 void SerialPort::drain_input() {

@@ -23,11 +23,11 @@ struct Region {
 };
 
 struct Mesh {
-  int order = 1;      // polynomial order of the tetrahedra: 1 or 2
-  RowMatrixXd X;      // reference coordinates, n_nodes x 3 [m]
-  RowMatrixXi cells;  // n_cells x (4 | 10), VTK ordering
+  int order = 1;                 // polynomial order of the tetrahedra: 1 or 2
+  RowMatrixXd X;                 // reference coordinates, n_nodes x 3 [m]
+  RowMatrixXi cells;             // n_cells x (4 | 10), VTK ordering
   std::vector<int> cell_region;  // region id per cell (dim 3)
-  RowMatrixXi faces;  // boundary triangles n_faces x (3 | 6), outward from the solid
+  RowMatrixXi faces;             // boundary triangles n_faces x (3 | 6), outward from the solid
   std::vector<int> face_region;  // region id per face (dim 2)
   std::vector<Region> regions;
 

@@ -11,8 +11,8 @@ namespace morphfem {
 
 struct Partition {
   int n_parts = 1;
-  std::vector<int> cell_part;    // part of each cell
-  std::vector<int> node_begin;   // nodes [node_begin[p], node_begin[p+1]) belong to part p
+  std::vector<int> cell_part;   // part of each cell
+  std::vector<int> node_begin;  // nodes [node_begin[p], node_begin[p+1]) belong to part p
 };
 
 // Splits `mesh` into `n_parts` with METIS (dual graph of cells sharing a face) and

@@ -47,13 +47,13 @@ struct Cavity {
 };
 
 struct Assembly {
-  std::vector<Piece> pieces;       // solid boxes, touching but not overlapping
-  std::vector<Cavity> cavities;    // closed empty boxes enclosed by the pieces
-  std::vector<std::string> volume_order;   // volume regions in group order
-  double length = 0.0;             // body length along y
-  double foot_length = 0.0;        // feet: y in [0, foot_length] and [length - foot_length, length]
-  double foot_z = 0.0;             // z of the skin's bottom face (the feet plane)
-  double scale = 0.0;              // largest body dimension (for tolerances)
+  std::vector<Piece> pieces;              // solid boxes, touching but not overlapping
+  std::vector<Cavity> cavities;           // closed empty boxes enclosed by the pieces
+  std::vector<std::string> volume_order;  // volume regions in group order
+  double length = 0.0;                    // body length along y
+  double foot_length = 0.0;               // feet: y in [0, foot_length] and [length - foot_length, length]
+  double foot_z = 0.0;                    // z of the skin's bottom face (the feet plane)
+  double scale = 0.0;                     // largest body dimension (for tolerances)
 };
 
 // A fresh gmsh model for one build, removed when the scope ends (also on errors).
@@ -134,8 +134,8 @@ Mesh mesh_assembly(const Assembly& assembly, double mesh_size, int order, const 
   gmsh::vectorpair boxes;
   for (const Piece& piece : assembly.pieces) {
     const Vec3 size = piece.box.hi - piece.box.lo;
-    boxes.emplace_back(3, occ::addBox(piece.box.lo.x(), piece.box.lo.y(), piece.box.lo.z(), size.x(), size.y(),
-                                      size.z()));
+    boxes.emplace_back(3,
+                       occ::addBox(piece.box.lo.x(), piece.box.lo.y(), piece.box.lo.z(), size.x(), size.y(), size.z()));
   }
   gmsh::vectorpair fragments;
   std::vector<gmsh::vectorpair> unused_map;
@@ -176,7 +176,8 @@ Mesh mesh_assembly(const Assembly& assembly, double mesh_size, int order, const 
     }
     Vec3 step = Vec3::Zero();
     step(s.axis) = probe;
-    const bool solid_below = inside_solid(assembly, s.point - step), solid_above = inside_solid(assembly, s.point + step);
+    const bool solid_below = inside_solid(assembly, s.point - step),
+               solid_above = inside_solid(assembly, s.point + step);
     if (solid_below == solid_above) throw std::logic_error("robot geometry: cannot orient a boundary surface");
     const bool faces_down = s.axis == 2 && solid_above;
     if (!faces_down) {
@@ -243,8 +244,8 @@ struct CommonRobot {
   double bladder_thickness = 0.0, bladder_width = 0.0, foot_length = 0.0;
 };
 
-CommonRobot common_robot(const ParamSet& params, double width, double length, double core_gap, double edge,
-                         double seal, double bladder_thickness, double bladder_width, double foot_length) {
+CommonRobot common_robot(const ParamSet& params, double width, double length, double core_gap, double edge, double seal,
+                         double bladder_thickness, double bladder_width, double foot_length) {
   CommonRobot c;
   c.mesh_size = params.number_in("mesh_size", 1e-12, kHuge);
   c.order = params.integer_in("order", 1, 2, 1);
@@ -258,7 +259,8 @@ CommonRobot common_robot(const ParamSet& params, double width, double length, do
   c.foot_length = length_param(params, "foot_length", foot_length);
   require(2 * c.edge < c.width, params, "edge_width", "the two bonded edges must leave a core: 2 edge_width < width");
   require(2 * c.seal < c.length, params, "end_seal", "the two end seals must leave a core: 2 end_seal < length");
-  require(4 * c.bladder_width <= c.width, params, "bladder_width", "four bladder columns must fit: 4 bladder_width <= width");
+  require(4 * c.bladder_width <= c.width, params, "bladder_width",
+          "four bladder columns must fit: 4 bladder_width <= width");
   require(2 * c.foot_length < c.length, params, "foot_length", "the feet must not meet: 2 foot_length < length");
   return c;
 }
@@ -274,8 +276,7 @@ std::vector<std::string> volume_order(bool with_fabric) {
 
 Mesh build_robot_voxel(const ParamSet& params) {
   params.allow_only({"type", "mesh_size", "order", "width", "length", "layer_thickness", "core_gap", "edge_width",
-                     "end_seal", "bladder_thickness", "bladder_width", "bladder_start", "bladder_end",
-                     "foot_length"});
+                     "end_seal", "bladder_thickness", "bladder_width", "bladder_start", "bladder_end", "foot_length"});
   const CommonRobot c = common_robot(params, 0.15, 0.22, 0.002, 0.01, 0.01, 0.02, 0.03, 0.03);
   const double t = length_param(params, "layer_thickness", 0.01);
   const double y0 = params.number_in("bladder_start", 0.0, c.length, 0.03);
@@ -302,9 +303,8 @@ Mesh build_robot_voxel(const ParamSet& params) {
 }
 
 Mesh build_robot_physical(const ParamSet& params) {
-  params.allow_only({"type", "mesh_size", "order", "width", "length", "skin_thickness", "fabric_thickness",
-                     "core_gap", "edge_width", "end_seal", "bladder_thickness", "bladder_wall", "bladder_width",
-                     "foot_length"});
+  params.allow_only({"type", "mesh_size", "order", "width", "length", "skin_thickness", "fabric_thickness", "core_gap",
+                     "edge_width", "end_seal", "bladder_thickness", "bladder_wall", "bladder_width", "foot_length"});
   const CommonRobot c = common_robot(params, 0.10, 0.15, 0.001, 0.005, 0.005, 0.003, 0.02, 0.02);
   const double t = length_param(params, "skin_thickness", 0.003);
   const double tf = length_param(params, "fabric_thickness", 0.0005);

@@ -53,11 +53,13 @@ std::shared_ptr<const Material> neo_hookean(double mu) {
 class TestInertia : public EnergyTerm {
  public:
   TestInertia(const Mesh& mesh, const Partition& part, int rank, double density)
-      : mass_(mesh.n_nodes(), 0.0), velocity_(mesh.n_nodes(), Eigen::Vector3d::Zero()),
+      : mass_(mesh.n_nodes(), 0.0),
+        velocity_(mesh.n_nodes(), Eigen::Vector3d::Zero()),
         start_(mesh.n_nodes(), Eigen::Vector3d::Zero()) {
     for (int c = 0; c < mesh.n_cells(); ++c) {
       Eigen::Matrix3d J;
-      for (int i = 0; i < 3; ++i) J.col(i) = (mesh.X.row(mesh.cells(c, i + 1)) - mesh.X.row(mesh.cells(c, 0))).transpose();
+      for (int i = 0; i < 3; ++i)
+        J.col(i) = (mesh.X.row(mesh.cells(c, i + 1)) - mesh.X.row(mesh.cells(c, 0))).transpose();
       for (int a = 0; a < 4; ++a) mass_[mesh.cells(c, a)] += density * J.determinant() / 24.0;
     }
     for (int a = part.node_begin[rank]; a < part.node_begin[rank + 1]; ++a) nodes_.push_back(a);
@@ -181,10 +183,12 @@ TEST(ContactSolver, RestingBlockCarriesItsWeight) {
   for (int order : {1, 2}) {
     BlockScene scene(order, 0.05, 0.0, false, -1.0, false, 0.0, 1e-4);
     std::vector<DirichletCondition> bcs(2);
-    bcs[0] = {"xmin", scene.mesh.nodes_of_surface("xmin"), {true, false, false},
-              [](const Eigen::Vector3d&, double) { return Eigen::Vector3d::Zero(); }};
-    bcs[1] = {"ymin", scene.mesh.nodes_of_surface("ymin"), {false, true, false},
-              [](const Eigen::Vector3d&, double) { return Eigen::Vector3d::Zero(); }};
+    bcs[0] = {"xmin", scene.mesh.nodes_of_surface("xmin"), {true, false, false}, [](const Eigen::Vector3d&, double) {
+                return Eigen::Vector3d::Zero();
+              }};
+    bcs[1] = {"ymin", scene.mesh.nodes_of_surface("ymin"), {false, true, false}, [](const Eigen::Vector3d&, double) {
+                return Eigen::Vector3d::Zero();
+              }};
     QuasiStaticSolver solver(*scene.assembler, bcs, fixed_steps(1.0, 1.0));
     const RunStats stats = solver.run();
     ASSERT_TRUE(stats.completed) << stats.failure;
@@ -261,8 +265,8 @@ TEST(ContactSolver, QuasiStaticBlockSticksBelowTheFrictionLimit) {
   ASSERT_TRUE(stats.completed) << stats.failure;
   const double creep = scene.mean_displacement(solver.solution(), scene.downhill) - creep_start;
   EXPECT_GT(creep, 0.0);
-  EXPECT_LT(creep, 2 * eps_v);         // creep speed below eps_v
-  EXPECT_LT(creep, 1e-3 * kSide);      // issue 4: below 0.1 % of the block size over 1 s
+  EXPECT_LT(creep, 2 * eps_v);     // creep speed below eps_v
+  EXPECT_LT(creep, 1e-3 * kSide);  // issue 4: below 0.1 % of the block size over 1 s
   const Eigen::Vector3d normal_force = scene.ground->total_force(*scene.assembler, solver.solution());
   const auto fr = scene.friction->nodal_friction(*scene.assembler, solver.solution());
   const Eigen::Vector3d friction_force = fr.force.colwise().sum().transpose();

@@ -66,8 +66,9 @@ SolverOptions fixed_steps(double t_end, double dt) {
 }
 
 DirichletCondition clamp(const Mesh& mesh, const std::string& surface) {
-  return {surface, mesh.nodes_of_surface(surface), {true, true, true},
-          [](const Eigen::Vector3d&, double) { return Eigen::Vector3d::Zero(); }};
+  return {surface, mesh.nodes_of_surface(surface), {true, true, true}, [](const Eigen::Vector3d&, double) {
+            return Eigen::Vector3d::Zero();
+          }};
 }
 
 // One body (region "body"): elastic + inertia (+ gravity, + damping).
@@ -134,8 +135,8 @@ void set_field(Assembler& assembler, Vec u, const std::function<Eigen::Vector3d(
   assembler.scatter_all(field, u);
 }
 
-const Eigen::Vector3d kGravity(0, 0, -9.81);    // [m/s^2]
-const Eigen::Vector3d kV0(0.3, -0.2, 1.0);      // [m/s]
+const Eigen::Vector3d kGravity(0, 0, -9.81);  // [m/s^2]
+const Eigen::Vector3d kV0(0.3, -0.2, 1.0);    // [m/s]
 
 }  // namespace
 
@@ -284,9 +285,8 @@ SwingResult swing(TimeScheme scheme, double dt, int steps, double eta = 0.0) {
   InertiaOptions options;
   options.scheme = scheme;
   Scene scene(make_mesh("cantilever", L, 0.02, 0.02, 0.01, 1), 1e5, 0.45, options, Eigen::Vector3d::Zero(), eta);
-  scene.inertia->set_initial_velocity([&](const Eigen::Vector3d& X) {
-    return Eigen::Vector3d(0, 0, V * (X.x() / L) * (X.x() / L));
-  });
+  scene.inertia->set_initial_velocity(
+      [&](const Eigen::Vector3d& X) { return Eigen::Vector3d(0, 0, V * (X.x() / L) * (X.x() / L)); });
   QuasiStaticSolver solver(*scene.assembler, {clamp(scene.mesh, "root")}, fixed_steps(steps * dt, dt));
   scene.inertia->initialize(*scene.assembler, solver.solution(), 0.0);
   SwingResult r;
@@ -357,9 +357,8 @@ BarResult axial_bar(TimeScheme scheme, int steps_per_period, double periods) {
   InertiaOptions options;
   options.scheme = scheme;
   Scene scene(make_mesh("cantilever", L, 0.0125, 0.0125, 0.0125, 2), mu, 0.0, options, Eigen::Vector3d::Zero());
-  scene.inertia->set_initial_velocity([&](const Eigen::Vector3d& X) {
-    return Eigen::Vector3d(V * std::sin(M_PI * X.x() / (2 * L)), 0, 0);
-  });
+  scene.inertia->set_initial_velocity(
+      [&](const Eigen::Vector3d& X) { return Eigen::Vector3d(V * std::sin(M_PI * X.x() / (2 * L)), 0, 0); });
   const double dt = T / steps_per_period;
   const int steps = static_cast<int>(std::lround(periods * steps_per_period));
   QuasiStaticSolver solver(*scene.assembler, {clamp(scene.mesh, "root")}, fixed_steps(steps * dt, dt));

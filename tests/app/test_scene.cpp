@@ -116,8 +116,9 @@ TEST(Scene, YamlSyntaxErrorNamesTheLine) {
 }
 
 TEST(Scene, MissingMeshFileIsNamed) {
-  std::string e = error_of(replace(kGood, "geometry: {type: block, lx: 0.01, ly: 0.01, lz: 0.01, mesh_size: 0.005, order: 1}",
-                                   "mesh: {file: nowhere.msh}"));
+  std::string e =
+      error_of(replace(kGood, "geometry: {type: block, lx: 0.01, ly: 0.01, lz: 0.01, mesh_size: 0.005, order: 1}",
+                       "mesh: {file: nowhere.msh}"));
   EXPECT_NE(e.find("nowhere.msh"), std::string::npos) << e;
 }
 
@@ -128,9 +129,7 @@ TEST(Scene, GravityWithoutDensityIsRejected) {
   EXPECT_NE(e.find("density"), std::string::npos) << e;
 }
 
-TEST(Scene, MissingFileIsAnInputError) {
-  EXPECT_THROW(read_scene("/nonexistent/scene.yaml"), InputError);
-}
+TEST(Scene, MissingFileIsAnInputError) { EXPECT_THROW(read_scene("/nonexistent/scene.yaml"), InputError); }
 
 TEST(Scene, GamgWithRigidBodyNearNullspaceMatchesMumps) {
   const std::string text = replace(kGood, "mu: 1.0e5, kappa: 1.0e6, density: 1000}",

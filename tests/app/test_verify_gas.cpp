@@ -274,5 +274,6 @@ TEST(VerifyGas, DISABLED_FullLadders) {
     gas_valve_case(opt, PETSC_COMM_WORLD, out);
   }
   for (const auto& r : out) std::printf("%s\n", r.json().c_str());
-  if (w == "diagnostic") std::printf("%s\n", run_pressure_controlled_balloon(true, PETSC_COMM_WORLD).stats.failure.c_str());
+  if (w == "diagnostic")
+    std::printf("%s\n", run_pressure_controlled_balloon(true, PETSC_COMM_WORLD).stats.failure.c_str());
 }

@@ -26,9 +26,12 @@ VerifyOptions quick() {
 // Cube of side 10 mm, P2, bonded at zmin, dead shear traction 0.2 mu on zmax.
 Scene sheared_cube(const std::string& formulation, double nu, int order = 2, int divisions = 2) {
   const double L = 0.01, mu = 1e5;
-  Scene s = verification_scene("cube", verification_params({{"lx", L}, {"ly", L}, {"lz", L}, {"mesh_size", L / divisions},
-                                                            {"order", double(order)}, {"structured", 1}}, "type", "block"),
-                               verification_params({{"mu", mu}, {"nu", nu}}, "model", "neo_hookean"));
+  Scene s = verification_scene(
+      "cube",
+      verification_params(
+          {{"lx", L}, {"ly", L}, {"lz", L}, {"mesh_size", L / divisions}, {"order", double(order)}, {"structured", 1}},
+          "type", "block"),
+      verification_params({{"mu", mu}, {"nu", nu}}, "model", "neo_hookean"));
   s.formulation = formulation;
   BoundarySpec clamp;
   clamp.surface = "zmin";
@@ -57,9 +60,11 @@ TEST(MeanDilatationSolve, PatchTestIsExactOnADistortedP2Mesh) {
   Mat3 F;
   F << 1.10, 0.05, 0.00, 0.02, 0.95, 0.03, 0.00, 0.04, 1.05;
   const Mat3 G = F - Mat3::Identity();
-  Scene s = verification_scene("patch_md", verification_params({{"lx", L}, {"ly", L}, {"lz", L}, {"mesh_size", L / 3},
-                                                                {"order", 2}, {"distort", 0.25}}, "type", "block"),
-                               verification_params({{"mu", 1e5}, {"nu", 0.4999}}, "model", "neo_hookean"));
+  Scene s = verification_scene(
+      "patch_md",
+      verification_params({{"lx", L}, {"ly", L}, {"lz", L}, {"mesh_size", L / 3}, {"order", 2}, {"distort", 0.25}},
+                          "type", "block"),
+      verification_params({{"mu", 1e5}, {"nu", 0.4999}}, "model", "neo_hookean"));
   s.formulation = "mean_dilatation";
   for (const char* face : {"xmin", "xmax", "ymin", "ymax", "zmin", "zmax"}) {
     BoundarySpec b;

@@ -54,7 +54,8 @@ void check_piece_fd(const EnergyTerm& term, int k, const PieceState& s, double h
     g_fd[j] = (ep - em) / (2 * h);
     H_fd.col(j) = (gp - gm) / (2 * h);
   }
-  EXPECT_LT((g - g_fd).norm(), 1e-6 * (g.norm() + 1e-12)) << what << "\n g " << g.transpose() << "\n fd " << g_fd.transpose();
+  EXPECT_LT((g - g_fd).norm(), 1e-6 * (g.norm() + 1e-12))
+      << what << "\n g " << g.transpose() << "\n fd " << g_fd.transpose();
   EXPECT_LT((H - H_fd).norm(), 1e-6 * (H.norm() + 1e-12)) << what << "\n H\n" << H << "\n fd\n" << H_fd;
   EXPECT_LT((H - H.transpose()).norm(), 1e-12 * (H.norm() + 1e-30)) << what;
 }
@@ -175,8 +176,8 @@ TEST(FrictionLaw, IsContinuousWithTheStatedLimitsAndDerivatives) {
     EXPECT_NEAR(f.force(2 * eps), mu_k, 1e-15);  // kinetic value from 2 eps on
     EXPECT_NEAR(f.force(10 * eps), mu_k, 1e-15);
     EXPECT_NEAR(f.force_over_y(0), 2 * 0.5 / eps, 1e-9);
-    for (double y : {0.1 * eps, 0.5 * eps, 0.999 * eps, 1.001 * eps, 1.3 * eps, 1.7 * eps, 1.999 * eps, 2.001 * eps,
-                     3 * eps}) {
+    for (double y :
+         {0.1 * eps, 0.5 * eps, 0.999 * eps, 1.001 * eps, 1.3 * eps, 1.7 * eps, 1.999 * eps, 2.001 * eps, 3 * eps}) {
       const double h = 1e-6 * eps;
       EXPECT_NEAR(f.force(y), (f.potential(y + h) - f.potential(y - h)) / (2 * h), 1e-7) << y / eps;
       EXPECT_NEAR(f.dforce(y), (f.force(y + h) - f.force(y - h)) / (2 * h), 1e-6 / eps) << y / eps;
@@ -242,9 +243,9 @@ TEST_P(FrictionFD, GradientAndHessianMatchFiniteDifferences) {
         EXPECT_LT(g.norm(), 1e-12);
         continue;
       }
-      check_piece_fd(term, k, s, fd_h,
-                     "order " + std::to_string(order) + " y/eps " + std::to_string(y_over_eps) + " mu_k " +
-                         std::to_string(mu_k));
+      check_piece_fd(
+          term, k, s, fd_h,
+          "order " + std::to_string(order) + " y/eps " + std::to_string(y_over_eps) + " mu_k " + std::to_string(mu_k));
     }
   }
 }

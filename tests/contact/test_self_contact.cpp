@@ -20,10 +20,12 @@ Eigen::Matrix<double, 4, 3> configuration(int feature, double d, std::mt19937& r
   x.row(1) << 0, 0, 0;
   x.row(2) << 1, 0, 0;
   x.row(3) << 0, 1, 0;
-  Eigen::RowVector3d foot = feature == 3 ? Eigen::RowVector3d(0.3, 0.3, 0) : feature == 2 ? Eigen::RowVector3d(0.5, 0, 0)
-                                                                                          : Eigen::RowVector3d(0, 0, 0);
-  Eigen::RowVector3d dir = feature == 3 ? Eigen::RowVector3d(0, 0, 1) : feature == 2 ? Eigen::RowVector3d(0, -0.6, 0.8)
-                                                                                     : Eigen::RowVector3d(-0.5, -0.5, 0.7071);
+  Eigen::RowVector3d foot = feature == 3   ? Eigen::RowVector3d(0.3, 0.3, 0)
+                            : feature == 2 ? Eigen::RowVector3d(0.5, 0, 0)
+                                           : Eigen::RowVector3d(0, 0, 0);
+  Eigen::RowVector3d dir = feature == 3   ? Eigen::RowVector3d(0, 0, 1)
+                           : feature == 2 ? Eigen::RowVector3d(0, -0.6, 0.8)
+                                          : Eigen::RowVector3d(-0.5, -0.5, 0.7071);
   x *= 1e-2;
   x.row(0) = 1e-2 * foot + d * dir.normalized();
   for (int a = 0; a < 4; ++a)
@@ -44,7 +46,8 @@ TEST(SelfContactKernel, DistanceMatchesDenseSampling) {
     const int n = 300;
     for (int i = 0; i <= n; ++i)
       for (int j = 0; i + j <= n; ++j) {
-        const Eigen::RowVector3d y = x.row(1) + (double(i) / n) * (x.row(2) - x.row(1)) + (double(j) / n) * (x.row(3) - x.row(1));
+        const Eigen::RowVector3d y =
+            x.row(1) + (double(i) / n) * (x.row(2) - x.row(1)) + (double(j) / n) * (x.row(3) - x.row(1));
         best = std::min(best, (x.row(0) - y).norm());
       }
     const double d = point_triangle_distance(x);
@@ -72,7 +75,8 @@ TEST(SelfContactKernel, BarrierGradientAndHessianMatchFiniteDifferences) {
         xm(j / 3, j % 3) -= h;
         Eigen::VectorXd gp, gm;
         g_fd[j] = (point_triangle_barrier(xp, area, kappa, dhat, &gp, nullptr) -
-                   point_triangle_barrier(xm, area, kappa, dhat, &gm, nullptr)) / (2 * h);
+                   point_triangle_barrier(xm, area, kappa, dhat, &gm, nullptr)) /
+                  (2 * h);
         H_fd.col(j) = (gp - gm) / (2 * h);
       }
       EXPECT_LT((g - g_fd).norm(), 1e-6 * g.norm()) << "feature " << feature << " s " << s;

@@ -15,7 +15,11 @@ namespace {
 
 // Exact integral over the reference tet of x^a y^b z^c: a! b! c! / (a+b+c+3)!
 double monomial_integral(int a, int b, int c) {
-  auto fact = [](int n) { double f = 1; for (int i = 2; i <= n; ++i) f *= i; return f; };
+  auto fact = [](int n) {
+    double f = 1;
+    for (int i = 2; i <= n; ++i) f *= i;
+    return f;
+  };
   return fact(a) * fact(b) * fact(c) / fact(a + b + c + 3);
 }
 
@@ -53,12 +57,17 @@ TEST(Quadrature, TetRulesIntegrateMonomialsExactly) {
           double sum = 0;
           for (const auto& q : tet_quadrature(degree))
             sum += q.weight * std::pow(q.xi[0], a) * std::pow(q.xi[1], b) * std::pow(q.xi[2], c);
-          EXPECT_NEAR(sum, monomial_integral(a, b, c), 1e-12) << "degree " << degree << " x^" << a << " y^" << b << " z^" << c;
+          EXPECT_NEAR(sum, monomial_integral(a, b, c), 1e-12)
+              << "degree " << degree << " x^" << a << " y^" << b << " z^" << c;
         }
 }
 
 TEST(Quadrature, TriangleRulesIntegrateMonomialsExactly) {
-  auto fact = [](int n) { double f = 1; for (int i = 2; i <= n; ++i) f *= i; return f; };
+  auto fact = [](int n) {
+    double f = 1;
+    for (int i = 2; i <= n; ++i) f *= i;
+    return f;
+  };
   for (int degree = 1; degree <= 6; ++degree)
     for (int a = 0; a <= degree; ++a)
       for (int b = 0; a + b <= degree; ++b) {
@@ -90,7 +99,11 @@ TEST_P(ElasticFD, GradientAndHessianMatchFiniteDifferences) {
   ParamSet p("test");
   p.set_string("model", std::get<1>(GetParam()));
   if (std::get<1>(GetParam()) == "neo_hookean") p.set("mu", 1e5);
-  if (std::get<1>(GetParam()) == "yeoh") { p.set("c1", 2e4); p.set("c2", 3e3); p.set("c3", 1e2); }
+  if (std::get<1>(GetParam()) == "yeoh") {
+    p.set("c1", 2e4);
+    p.set("c2", 3e3);
+    p.set("c3", 1e2);
+  }
   p.set("kappa", 2e6);
   std::shared_ptr<const Material> law = make_material(p);
   Mesh mesh = single_tet(order, 7);
@@ -144,7 +157,8 @@ TEST(BodyForce, GravityWorkEqualsWeightTimesCentroidDrop) {
     Mesh mesh = single_tet(order, 2);
     Partition part{1, {0}, {0, mesh.n_nodes()}};
     const Eigen::Vector3d b(0, 0, -1000 * 9.81);
-    BodyForceTerm term(mesh, part, 0, {0}, [b](const Eigen::Vector3d&, double) { return b; }, 2);
+    BodyForceTerm term(
+        mesh, part, 0, {0}, [b](const Eigen::Vector3d&, double) { return b; }, 2);
     // Uniform translation d: E = -b.d V
     PieceState s{mesh.X, Eigen::MatrixXd::Zero(mesh.n_nodes(), 3)};
     s.u.col(2).setConstant(-0.01);

@@ -157,11 +157,12 @@ TEST(InertiaKernel, GradientAndHessianMatchFiniteDifferences) {
       const Eigen::MatrixXd M = element_mass_matrix(make_mass_table(order), X, 1200.0, lumped);
       const Eigen::MatrixXd pred = random_field(n, 1e-3, 11);
       const double c = 1.0 / (0.25 * 1e-3 * 1e-3);  // Newmark, h = 1 ms [1/s^2]
-      check_derivatives(random_field(n, 1e-3, 12), 1e-6,
-                        [&](const Eigen::MatrixXd& u, Eigen::VectorXd* g, Eigen::MatrixXd* H) {
-                          return inertia_kernel(M, c, u - pred, g, H);
-                        },
-                        1e-7, 1e-7);
+      check_derivatives(
+          random_field(n, 1e-3, 12), 1e-6,
+          [&](const Eigen::MatrixXd& u, Eigen::VectorXd* g, Eigen::MatrixXd* H) {
+            return inertia_kernel(M, c, u - pred, g, H);
+          },
+          1e-7, 1e-7);
     }
 }
 
@@ -172,11 +173,12 @@ TEST(DampingKernel, GradientAndHessianMatchFiniteDifferences) {
     const ShapeTable table = make_tet_table(order, order == 1 ? 1 : 2);
     // Large strains (up to ~30 %) at the step start and end.
     const std::vector<Mat3> E_n = green_lagrange_at_points(table, X, random_field(n, 2e-3, 21));
-    check_derivatives(random_field(n, 2e-3, 22), 1e-7,
-                      [&](const Eigen::MatrixXd& u, Eigen::VectorXd* g, Eigen::MatrixXd* H) {
-                        return viscous_damping_kernel(table, X, u, E_n, 300.0, 150.0, 1e-3, g, H);
-                      },
-                      1e-6, 1e-6);
+    check_derivatives(
+        random_field(n, 2e-3, 22), 1e-7,
+        [&](const Eigen::MatrixXd& u, Eigen::VectorXd* g, Eigen::MatrixXd* H) {
+          return viscous_damping_kernel(table, X, u, E_n, 300.0, 150.0, 1e-3, g, H);
+        },
+        1e-6, 1e-6);
   }
 }
 

@@ -1,12 +1,12 @@
 // Tensile-test reader and hyperelastic fits: synthetic data with known parameters,
 // the real Dragon Skin exports (and the presets fitted from them), malformed files.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
-#include <unistd.h>
 
 #include "core/errors.h"
 #include "core/params.h"
@@ -95,8 +95,7 @@ TEST(MaterialFit, ReadsTheDragonSkinExportsAndReproducesThePresets) {
 class MaterialFitFiles : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = std::filesystem::path(::testing::TempDir()) /
-           ("morphfem_material_fit_" + std::to_string(::getpid()));
+    dir_ = std::filesystem::path(::testing::TempDir()) / ("morphfem_material_fit_" + std::to_string(::getpid()));
     std::filesystem::create_directories(dir_);
   }
   void TearDown() override { std::filesystem::remove_all(dir_); }
@@ -146,17 +145,19 @@ TEST_F(MaterialFitFiles, RejectsMissingColumnsAndBadNumbers) {
       write("no_columns.csv", std::string(kHeader) + "Time (s);Temperature (C)\n0.1;20\n0.2;21\n");
   expect_error_at(no_columns, no_columns + ":6", "no usable stress-strain columns");
 
-  const std::string bad_number = write(
-      "bad_number.csv", std::string(kHeader) +
-                            "Time (s);Engineering Strain;Engineering Stress (MPa)\n0.1;0.1;0.01\n0.2;abc;0.02\n");
+  const std::string bad_number =
+      write("bad_number.csv", std::string(kHeader) +
+                                  "Time (s);Engineering Strain;Engineering Stress (MPa)\n0.1;0.1;0.01\n0.2;abc;0.02\n");
   expect_error_at(bad_number, bad_number + ":8", "'abc' is not a number");
 
-  const std::string short_row = write(
-      "short_row.csv", std::string(kHeader) + "Time (s);Engineering Strain;Engineering Stress (MPa)\n0.1;0.1;0.01\n0.2;0.2\n");
+  const std::string short_row =
+      write("short_row.csv",
+            std::string(kHeader) + "Time (s);Engineering Strain;Engineering Stress (MPa)\n0.1;0.1;0.01\n0.2;0.2\n");
   expect_error_at(short_row, short_row + ":8", "missing value");
 
-  const std::string bad_unit = write(
-      "bad_unit.csv", std::string(kHeader) + "Time (s);Engineering Strain;Engineering Stress (bar)\n0.1;0.1;0.01\n0.2;0.2;0.02\n");
+  const std::string bad_unit =
+      write("bad_unit.csv", std::string(kHeader) +
+                                "Time (s);Engineering Strain;Engineering Stress (bar)\n0.1;0.1;0.01\n0.2;0.2;0.02\n");
   expect_error_at(bad_unit, bad_unit + ":6", "unknown unit");
 
   const std::string no_data = write("no_data.csv", kHeader);

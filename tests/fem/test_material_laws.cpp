@@ -256,8 +256,8 @@ TEST(MaterialLaw, OgdenWithAlphaTwoIsNeoHookean) {
 TEST(MaterialLaw, OgdenTangentContinuousAtRepeatedStretches) {
   // Exactly repeated vs. split by 1e-9: the tangent must not jump.
   const auto m = make_material(make_params("ogden", {{"mu", {15e3, 1e3}}, {"alpha", {1.8, 5.0}}, {"kappa", {5e5}}}));
-  for (const auto& s : {Eigen::Vector3d(1.0, 1.0, 1.0), Eigen::Vector3d(1.4, 0.85, 0.85),
-                        Eigen::Vector3d(1.2, 1.2, 0.7)}) {
+  for (const auto& s :
+       {Eigen::Vector3d(1.0, 1.0, 1.0), Eigen::Vector3d(1.4, 0.85, 0.85), Eigen::Vector3d(1.2, 1.2, 0.7)}) {
     double W;
     Mat3 P;
     Tangent A_exact, A_split;
@@ -308,8 +308,7 @@ TEST(MaterialLaw, RejectsBadParameters) {
   expect_input_error(make_params("neo_hookean", {{"mu", {-1.0}}, {"kappa", {1e6}}}), "mu");
   expect_input_error(make_params("neo_hookean", {{"mu", {1e5}}, {"nu", {0.5}}}), "nu = 0.5");
   expect_input_error(make_params("neo_hookean", {{"mu", {1e5}}, {"kapa", {1e6}}}), "unknown key 'kapa'");
-  expect_input_error(make_params("mooney_rivlin", {{"c10", {30e3}}, {"c01", {-2e3}}, {"kappa", {1e6}}}),
-                     "not stable");
+  expect_input_error(make_params("mooney_rivlin", {{"c10", {30e3}}, {"c01", {-2e3}}, {"kappa", {1e6}}}), "not stable");
   expect_input_error(make_params("mooney_rivlin", {{"c10", {0.0}}, {"c01", {0.0}}, {"kappa", {1e6}}}),
                      "c10 + c01 must be > 0");
   expect_input_error(make_params("yeoh", {{"c1", {20e3}}, {"c3", {-5e3}}, {"kappa", {1e6}}}), "unstable");

@@ -44,9 +44,19 @@ std::shared_ptr<const Material> law(const std::string& name) {
   ParamSet p("test");
   p.set_string("model", name);
   if (name == "neo_hookean") p.set("mu", 1e5);
-  if (name == "mooney_rivlin") { p.set("c10", 4e4); p.set("c01", 1e4); }
-  if (name == "yeoh") { p.set("c1", 2e4); p.set("c2", 3e3); p.set("c3", 1e2); }
-  if (name == "ogden") { p.set("mu", std::vector<double>{6e4, -2e3}); p.set("alpha", std::vector<double>{1.8, -2.0}); }
+  if (name == "mooney_rivlin") {
+    p.set("c10", 4e4);
+    p.set("c01", 1e4);
+  }
+  if (name == "yeoh") {
+    p.set("c1", 2e4);
+    p.set("c2", 3e3);
+    p.set("c3", 1e2);
+  }
+  if (name == "ogden") {
+    p.set("mu", std::vector<double>{6e4, -2e3});
+    p.set("alpha", std::vector<double>{1.8, -2.0});
+  }
   p.set("kappa", 1e8);
   return make_material(p);
 }

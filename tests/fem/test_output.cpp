@@ -1,6 +1,4 @@
 // ResultWriter (XDMF + HDF5 time series) and the output-directory helpers.
-#include "fem/output.h"
-
 #include <gtest/gtest.h>
 #include <hdf5.h>
 #include <unistd.h>
@@ -17,6 +15,8 @@
 #include <set>
 #include <sstream>
 
+#include "fem/output.h"
+
 namespace fs = std::filesystem;
 using namespace morphfem;
 
@@ -27,8 +27,7 @@ struct TempDir {
   fs::path path;
   TempDir() {
     const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    path = fs::temp_directory_path() /
-           ("morphfem_output_" + std::to_string(::getpid()) + "_" + info->name());
+    path = fs::temp_directory_path() / ("morphfem_output_" + std::to_string(::getpid()) + "_" + info->name());
     fs::remove_all(path);
     fs::create_directories(path);
   }
@@ -282,8 +281,8 @@ void check_three_steps(const std::string& dir, const std::string& name, const Me
   EXPECT_EQ(X.values, std::vector<double>(mesh.X.data(), mesh.X.data() + mesh.X.size()));
   H5Data cells = read_dataset(f, "/mesh/cells");
   EXPECT_EQ(cells.type_class, H5T_INTEGER);
-  EXPECT_EQ(cells.dims, (std::vector<hsize_t>{static_cast<hsize_t>(mesh.n_cells()),
-                                               static_cast<hsize_t>(mesh.nodes_per_cell())}));
+  EXPECT_EQ(cells.dims,
+            (std::vector<hsize_t>{static_cast<hsize_t>(mesh.n_cells()), static_cast<hsize_t>(mesh.nodes_per_cell())}));
   EXPECT_EQ(cells.values, std::vector<double>(mesh.cells.data(), mesh.cells.data() + mesh.cells.size()));
   const double times[3] = {0.0, 0.1, 0.35};
   for (int s = 0; s < 3; ++s) {
@@ -300,8 +299,7 @@ void check_three_steps(const std::string& dir, const std::string& name, const Me
         if (field.components > 1) dims.push_back(field.components);
         EXPECT_EQ(d.dims, dims) << path;
         EXPECT_EQ(d.values, field.values) << path;
-        EXPECT_EQ(read_string_attribute(f, path, "center"),
-                  std::vector<std::string>{kind == 0 ? "Node" : "Cell"});
+        EXPECT_EQ(read_string_attribute(f, path, "center"), std::vector<std::string>{kind == 0 ? "Node" : "Cell"});
       }
     }
   }
@@ -366,14 +364,20 @@ TEST(ResultWriter, RejectsNonFiniteValues) {
 
   Field bad = make_field("displacement", 3, 5, 1);
   bad.values[7] = std::nan("");
-  expect_throw_containing([&] { w.write_step(1.0, {make_field("J", 1, 5, 0), bad}, {}); },
-                          {"'displacement'", "step 1", "node 2", "component 1"});
+  expect_throw_containing(
+      [&] {
+        w.write_step(1.0, {make_field("J", 1, 5, 0), bad}, {});
+      },
+      {"'displacement'", "step 1", "node 2", "component 1"});
   Field inf = make_field("von_mises", 1, 2, 0);
   inf.values[1] = -std::numeric_limits<double>::infinity();
   expect_throw_containing([&] { w.write_step(1.0, {}, {inf}); }, {"'von_mises'", "step 1", "cell 1"});
   expect_throw_containing([&] { w.write_step(std::nan(""), {}, {}); }, {"step 1", "time"});
-  expect_throw_containing([&] { w.append_row("cavities", {"time", "volume"}, {1.0, std::nan("")}); },
-                          {"cavities", "'volume'"});
+  expect_throw_containing(
+      [&] {
+        w.append_row("cavities", {"time", "volume"}, {1.0, std::nan("")});
+      },
+      {"cavities", "'volume'"});
   EXPECT_EQ(w.steps_written(), 1);
 
   // Nothing of the rejected steps was written; the next good step is step 1.
@@ -419,8 +423,7 @@ TEST(ResultWriter, RejectsWrongSizesAndNames) {
   Mesh wrong_order = p1_mesh();
   wrong_order.order = 2;
   expect_throw_containing([&] { ResultWriter(dir.str(), "order", wrong_order); }, {"columns", "expected 10"});
-  expect_throw_containing([&] { ResultWriter((dir.path / "missing").string(), "x", p1_mesh()); },
-                          {"does not exist"});
+  expect_throw_containing([&] { ResultWriter((dir.path / "missing").string(), "x", p1_mesh()); }, {"does not exist"});
 }
 
 // A run that dies leaves files readable up to the last completed step. The files
@@ -504,8 +507,7 @@ TEST(OutputDir, RefusesToReplaceAFile) {
   expect_throw_containing([&] { commit_output_dir(tmp, final_dir); }, {"not a directory"});
   EXPECT_TRUE(fs::is_directory(tmp));
   EXPECT_EQ(read_text(final_dir), "not a directory");
-  expect_throw_containing([&] { commit_output_dir((dir.path / "nothing").string(), final_dir); },
-                          {"not a directory"});
+  expect_throw_containing([&] { commit_output_dir((dir.path / "nothing").string(), final_dir); }, {"not a directory"});
   expect_throw_containing([&] { temporary_output_dir(""); }, {"not a usable output directory"});
 }
 
@@ -518,8 +520,8 @@ TEST(ResultWriter, PythonCheckerAgrees) {
   write_three_steps(dir.str(), "p2", p2);
   const std::string script = std::string(MORPHFEM_SOURCE_DIR) + "/scripts/check_xdmf.py";
   const std::string log = dir.str() + "/check.log";
-  const std::string cmd = "/usr/bin/python3 " + script + " " + dir.str() + "/p1.xdmf " + dir.str() +
-                          "/p2.xdmf >" + log + " 2>&1";
+  const std::string cmd =
+      "/usr/bin/python3 " + script + " " + dir.str() + "/p1.xdmf " + dir.str() + "/p2.xdmf >" + log + " 2>&1";
   EXPECT_EQ(std::system(cmd.c_str()), 0) << read_text(log);
 
   // And it notices a wrong dimension (so the check above means something).

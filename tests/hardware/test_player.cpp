@@ -44,8 +44,10 @@ std::string map_text(const std::string& dir, bool all_alicat, double bladder_max
   m << "channels:\n";
   for (int b = 0; b < 8; ++b) {
     m << "  b" << b + 1 << ": {device: " << (all_alicat ? "bus" : "bridge") << ", address: ";
-    if (all_alicat) m << char('D' + b);
-    else m << "0x" << std::hex << 0x11 + b << std::dec;
+    if (all_alicat)
+      m << char('D' + b);
+    else
+      m << "0x" << std::hex << 0x11 + b << std::dec;
     m << ", min_pa: -5000, max_pa: " << bladder_max << "}\n";
   }
   m << "  core: {device: bus, address: A, inflated_pa: 30000, min_pa: -85000, max_pa: 55000}\n"
@@ -139,7 +141,9 @@ TEST(ChannelMapFile, ErrorsNameFileLineAndReason) {
   EXPECT_NE(e.find("max_pa"), std::string::npos) << e;
   e = err(head + "  b9: {device: bus, address: A, min_pa: 0, max_pa: 1}\n");
   EXPECT_NE(e.find("unknown channel 'b9'"), std::string::npos) << e;
-  e = err(head + "  b1: {device: bus, address: A, min_pa: 0, max_pa: 1}\n  b2: {device: bus, address: A, min_pa: 0, max_pa: 1}\n");
+  e = err(
+      head +
+      "  b1: {device: bus, address: A, min_pa: 0, max_pa: 1}\n  b2: {device: bus, address: A, min_pa: 0, max_pa: 1}\n");
   EXPECT_NE(e.find("map.yaml:6:"), std::string::npos) << e;
   EXPECT_NE(e.find("already used"), std::string::npos) << e;
   e = err(head + "  b1: {device: bus, address: A, min_pa: 0, max_pa: 100, inflated_pa: 200}\n");
@@ -256,7 +260,7 @@ TEST(Player, SettleModeAdvancesWhenPressuresSettle) {
   PressureTrace tr = read_pressure_log(rig.opt.log_path);
   int settled = 0;
   for (auto& e : tr.events) settled += e.message.rfind("settled", 0) == 0;
-  EXPECT_EQ(settled, 9);                    // rest + 8 columns
+  EXPECT_EQ(settled, 9);                   // rest + 8 columns
   EXPECT_LT(tr.duration(), s.duration());  // faster than fixed 1.237 s columns
   EXPECT_TRUE(rig.emu->all_vented());
 }

@@ -21,16 +21,16 @@ TEST(Alicat, CommandsAndFrames) {
   EXPECT_NEAR(r.frame.setpoint_pa, 25000, 1e-6);
   EXPECT_EQ(r.frame.status.at(0), "HLD");
   EXPECT_EQ(parse_alicat_reply("?\r", 'B').status, ReplyStatus::rejected);
-  EXPECT_EQ(parse_alicat_reply(s, 'A').status, ReplyStatus::malformed);         // wrong unit
+  EXPECT_EQ(parse_alicat_reply(s, 'A').status, ReplyStatus::malformed);  // wrong unit
   EXPECT_EQ(parse_alicat_reply("B +02#.991 +025.000\r", 'B').status, ReplyStatus::malformed);
   EXPECT_EQ(parse_alicat_reply("B +024.991\r", 'B').status, ReplyStatus::malformed);
   EXPECT_EQ(parse_alicat_reply("B +1 +2 toolong\r", 'B').status, ReplyStatus::malformed);
 }
 
 TEST(Booth, SensorTransferFunctionAndRegisters) {
-  booth::Sensor s;  // -100..100 kPa
-  EXPECT_EQ(s.counts(-100000), 102);   // 10 % of 1023
-  EXPECT_EQ(s.counts(100000), 921);    // 90 %
+  booth::Sensor s;                    // -100..100 kPa
+  EXPECT_EQ(s.counts(-100000), 102);  // 10 % of 1023
+  EXPECT_EQ(s.counts(100000), 921);   // 90 %
   EXPECT_EQ(s.counts(0), 512);
   EXPECT_EQ(s.counts(-1e9), 0);
   EXPECT_EQ(s.counts(1e9), 1023);

@@ -64,7 +64,7 @@ TEST(GenomeRow, PhiBeyondTheRow) {
   EXPECT_EQ(genome_row(1, 8), (std::vector<int>{1, 0, 1, 0, 1, 0, 1, 0}));  // 9-2, 9-4, ...
   EXPECT_EQ(genome_row(3, 8), (std::vector<int>{1, 0, 0, 0, 1, 0, 0, 0}));  // 9-4 = 5, 9-8 = 1
   EXPECT_EQ(genome_row(7, 8), (std::vector<int>{1, 0, 0, 0, 0, 0, 0, 0}));  // 9-8 = 1
-  EXPECT_EQ(genome_row(8, 8), std::vector<int>(8, 0));                    // 9 +/- 9 = 0, 18
+  EXPECT_EQ(genome_row(8, 8), std::vector<int>(8, 0));                      // 9 +/- 9 = 0, 18
 }
 
 TEST(GenomeRow, LargestFrequencyGivesOneColumn) {

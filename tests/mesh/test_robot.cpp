@@ -244,14 +244,13 @@ TEST(RobotGeometry, PhysicalPreset) {
 
 TEST(RobotGeometry, OverridesAndBadParameters) {
   // A thinner gap and narrower bonded edges change the core volume accordingly.
-  const Mesh mesh = build_geometry(
-      robot_params("robot_voxel", {{"mesh_size", 0.03}, {"core_gap", 0.001}, {"edge_width", 0.02}}));
+  const Mesh mesh =
+      build_geometry(robot_params("robot_voxel", {{"mesh_size", 0.03}, {"core_gap", 0.001}, {"edge_width", 0.02}}));
   const auto [core, residual] = enclosed_volume(mesh, {"core_wall"});
   EXPECT_NEAR(core, (kW - 0.04) * (kL - 2 * kSeal) * 0.001, 1e-10 * core);
 
   EXPECT_THROW(build_geometry(robot_params("robot_voxel", {{"mesh_size", 0.03}, {"edge_width", 0.08}})), InputError);
-  EXPECT_THROW(build_geometry(robot_params("robot_voxel", {{"mesh_size", 0.03}, {"bladder_width", 0.04}})),
-               InputError);
+  EXPECT_THROW(build_geometry(robot_params("robot_voxel", {{"mesh_size", 0.03}, {"bladder_width", 0.04}})), InputError);
   EXPECT_THROW(build_geometry(robot_params("robot_voxel", {{"mesh_size", 0.03}, {"core_gapp", 0.001}})), InputError);
   EXPECT_THROW(build_geometry(robot_params("robot_voxel", {{"mesh_size", 0.03}, {"core_gap", 0.0}})), InputError);
   EXPECT_THROW(build_geometry(robot_params("robot_physical", {{"mesh_size", 0.03}, {"bladder_wall", 0.002}})),
@@ -268,8 +267,9 @@ TEST(RobotGeometry, PhysicalPresetP2) {
     const auto [v, residual] = enclosed_volume(mesh, {"bladder_" + std::to_string(k) + "_wall"});
     EXPECT_NEAR(v, chamber, 1e-10 * chamber) << k;
   }
-  EXPECT_NEAR(mesh.volume(), region_volume(mesh, "skin") + region_volume(mesh, "fabric") +
-                                 8 * region_volume(mesh, "bladder_1"), 1e-9 * mesh.volume());
+  EXPECT_NEAR(mesh.volume(),
+              region_volume(mesh, "skin") + region_volume(mesh, "fabric") + 8 * region_volume(mesh, "bladder_1"),
+              1e-9 * mesh.volume());
   expect_downward_in_plane(mesh, "foot_b", 0.003, 0.13, 0.15);
 }
 
