@@ -169,3 +169,37 @@ TEST(Scene, GasCavityFillsTowardsTheSupplyPressure) {
   EXPECT_GT(pressure.back(), 1000.0);
   EXPECT_LT(pressure.back(), 5000.0);  // below the 5 kPa supply
 }
+
+// A thin neo-Hookean balloon under pressure control past its maximum
+// (1.239 mu H/R): the run stops with a diagnostic, keeps the last converged state
+// in the output (status "failed" in summary.json) and writes no NaN.
+TEST(Scene, PressureControlPastTheLimitPointFailsGracefully) {
+  TempScene s(R"(name: balloon
+geometry: {type: spherical_shell, inner_radius: 0.010, outer_radius: 0.0105, mesh_size: 0.003, order: 2}
+materials:
+  body: {model: neo_hookean, mu: 1.0e5, kappa: 1.0e8}
+boundary:
+  - {surface: sym_x, fix: [x]}
+  - {surface: sym_y, fix: [y]}
+  - {surface: sym_z, fix: [z]}
+loads:
+  cavities:
+    - {name: inside, surfaces: [inner], pressure: 9000}
+solver: {end_time: 1, initial_step: 0.1, max_step: 0.1, min_step: 1.0e-3, formulation: mean_dilatation}
+output: {directory: OUT}
+)");
+  Scene scene = read_scene(s.file.string());
+  auto r = run_scene(scene, PETSC_COMM_WORLD, {true, false, {}});
+  EXPECT_FALSE(r.stats.completed);
+  EXPECT_NE(r.stats.failure.find("no convergence"), std::string::npos) << r.stats.failure;
+  EXPECT_NE(r.stats.failure.find("t = "), std::string::npos) << r.stats.failure;
+  // The last converged pressure is below the thin-shell maximum (about 6 kPa here) and the state is finite.
+  ASSERT_EQ(r.cavity_pressure.size(), 1u);
+  EXPECT_LT(r.cavity_pressure[0], 6600.0);
+  EXPECT_GT(r.cavity_pressure[0], 4000.0);
+  EXPECT_TRUE(r.u.allFinite());
+  std::ifstream summary(s.dir / "out" / "summary.json");
+  std::string text((std::istreambuf_iterator<char>(summary)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("\"status\": \"failed\""), std::string::npos) << text;
+  EXPECT_TRUE(fs::exists(s.dir / "out" / "balloon.xdmf"));
+}
