@@ -12,6 +12,7 @@
 #include <stdexcept>
 
 #include "core/errors.h"
+#include "core/yaml_reader.h"
 
 namespace morphfem {
 
@@ -23,65 +24,8 @@ const std::array<std::string, kNumChannels> kChannelNames = {"b1", "b2", "b3",  
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-std::string fmt(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
-
-// --- YAML helpers: every error names file:line:col and the key path -------------
-struct Reader {
-  std::string source;
-
-  std::string where(const YAML::Node& n, const std::string& key) const {
-    std::string w = source;
-    if (n.IsDefined() && n.Mark().line >= 0)
-      w += ":" + std::to_string(n.Mark().line + 1) + ":" + std::to_string(n.Mark().column + 1);
-    return key.empty() ? w : w + ": " + key;
-  }
-  [[noreturn]] void fail(const YAML::Node& n, const std::string& key, const std::string& what) const {
-    throw InputError(where(n, key), what);
-  }
-  double number(const YAML::Node& n, const std::string& key) const {
-    if (!n.IsScalar()) fail(n, key, "expected a number");
-    const std::string& s = n.Scalar();
-    char* end = nullptr;
-    double v = std::strtod(s.c_str(), &end);
-    if (s.empty() || end != s.c_str() + s.size()) fail(n, key, "expected a number, got '" + s + "'");
-    if (!std::isfinite(v)) fail(n, key, "value is not a finite number");
-    return v;
-  }
-  double number_in(const YAML::Node& n, const std::string& key, double lo, double hi) const {
-    double v = number(n, key);
-    if (v < lo || v > hi)
-      fail(n, key, "value " + fmt(v) + " is outside the allowed range [" + fmt(lo) + ", " + fmt(hi) + "]");
-    return v;
-  }
-  int integer_in(const YAML::Node& n, const std::string& key, int lo, int hi) const {
-    double v = number(n, key);
-    if (v != std::floor(v)) fail(n, key, "expected an integer, got " + fmt(v));
-    if (v < lo || v > hi)
-      fail(
-          n, key,
-          "value " + fmt(v) + " is outside the allowed range [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
-    return static_cast<int>(v);
-  }
-  std::string text(const YAML::Node& n, const std::string& key) const {
-    if (!n.IsScalar()) fail(n, key, "expected text");
-    return n.Scalar();
-  }
-  void allow_only(const YAML::Node& map, const std::string& key, const std::set<std::string>& allowed) const {
-    if (!map.IsMap()) fail(map, key, "expected a mapping (key: value)");
-    for (auto it = map.begin(); it != map.end(); ++it) {
-      std::string k = it->first.Scalar();
-      if (!allowed.count(k)) {
-        std::string list;
-        for (auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
-        fail(it->first, key.empty() ? k : key + "." + k, "unknown key '" + k + "' (allowed: " + list + ")");
-      }
-    }
-  }
-};
+// YAML helpers (core/yaml_reader.h): every error names file:line:col and the key path.
+using Reader = YamlReader;
 
 std::vector<int> parse_row(const Reader& r, const YAML::Node& n, const std::string& key) {
   std::vector<int> row;

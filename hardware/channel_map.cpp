@@ -9,53 +9,13 @@
 #include <sstream>
 
 #include "core/errors.h"
+#include "core/yaml_reader.h"
 
 namespace morphfem::hw {
 
 namespace {
 
-std::string fmt(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
-
-struct MapReader {
-  std::string source;
-  std::string where(const YAML::Node& n, const std::string& key) const {
-    std::string w = source;
-    if (n.IsDefined() && n.Mark().line >= 0)
-      w += ":" + std::to_string(n.Mark().line + 1) + ":" + std::to_string(n.Mark().column + 1);
-    return key.empty() ? w : w + ": " + key;
-  }
-  [[noreturn]] void fail(const YAML::Node& n, const std::string& key, const std::string& what) const {
-    throw InputError(where(n, key), what);
-  }
-  double number(const YAML::Node& n, const std::string& key) const {
-    if (!n.IsScalar()) fail(n, key, "expected a number");
-    const std::string& s = n.Scalar();
-    char* end = nullptr;
-    double v = std::strtod(s.c_str(), &end);
-    if (s.empty() || end != s.c_str() + s.size()) fail(n, key, "expected a number, got '" + s + "'");
-    if (!std::isfinite(v)) fail(n, key, "value is not a finite number");
-    return v;
-  }
-  std::string text(const YAML::Node& n, const std::string& key) const {
-    if (!n.IsScalar()) fail(n, key, "expected text");
-    return n.Scalar();
-  }
-  void allow_only(const YAML::Node& map, const std::string& key, const std::set<std::string>& allowed) const {
-    if (!map.IsMap()) fail(map, key, "expected a mapping (key: value)");
-    for (auto it = map.begin(); it != map.end(); ++it) {
-      std::string k = it->first.Scalar();
-      if (!allowed.count(k)) {
-        std::string list;
-        for (auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
-        fail(it->first, key.empty() ? k : key + "." + k, "unknown key '" + k + "' (allowed: " + list + ")");
-      }
-    }
-  }
-};
+using MapReader = YamlReader;
 
 }  // namespace
 
@@ -108,9 +68,9 @@ void ChannelMap::check_schedule(const Schedule& s) const {
     auto check = [&](double p, const char* what) {
       if (p < c->min_pa || p > c->max_pa)
         throw InputError(c->where, std::string("refused before sending anything: schedule ") + sw + " needs " + what +
-                                       " pressure " + fmt(p) + " Pa on " + channel_name(ch) +
-                                       ", outside this channel's limits [" + fmt(c->min_pa) + ", " + fmt(c->max_pa) +
-                                       "] Pa");
+                                       " pressure " + format_number(p) + " Pa on " + channel_name(ch) +
+                                       ", outside this channel's limits [" + format_number(c->min_pa) + ", " +
+                                       format_number(c->max_pa) + "] Pa");
     };
     if (uses_on) check(lv[ch].inflate_pa, ch == kChannelCore ? "core" : "inflate");
     if (uses_off && ch != kChannelCore) check(lv[ch].deflate_pa, "deflate");
@@ -158,7 +118,7 @@ ChannelMap parse_channel_map(const std::string& text, const std::string& source)
     if (n["baud"]) {
       double b = r.number(n["baud"], key + ".baud");
       static const std::set<double> ok = {9600, 19200, 38400, 57600, 115200, 230400, 460800, 921600};
-      if (!ok.count(b)) r.fail(n["baud"], key + ".baud", "unsupported baud rate " + fmt(b));
+      if (!ok.count(b)) r.fail(n["baud"], key + ".baud", "unsupported baud rate " + format_number(b));
       d.baud = static_cast<int>(b);
     }
     if (n["sensor_min_pa"]) d.sensor_min_pa = r.number(n["sensor_min_pa"], key + ".sensor_min_pa");
@@ -213,11 +173,11 @@ ChannelMap parse_channel_map(const std::string& text, const std::string& source)
     if (n["deflated_pa"]) c.deflated_pa = r.number(n["deflated_pa"], key + ".deflated_pa");
     auto within = [&](const std::optional<double>& v, const char* k) {
       if (!v || (*v >= c.min_pa && *v <= c.max_pa)) return;
-      std::string what = fmt(*v);
+      std::string what = format_number(*v);
       what += " Pa is outside this channel's limits [";
-      what += fmt(c.min_pa);
+      what += format_number(c.min_pa);
       what += ", ";
-      what += fmt(c.max_pa);
+      what += format_number(c.max_pa);
       what += "] Pa";
       std::string full_key = key;
       full_key += '.';
