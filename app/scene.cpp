@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <set>
 
+#include "actuation/schedule_loads.h"
 #include "core/errors.h"
 #include "fem/elastic.h"
 
@@ -123,7 +124,8 @@ Scene read_scene(const std::string& path) {
   }
   if (!root.IsMap()) throw InputError(path, "a scene must be a mapping with keys geometry/mesh, materials, ...");
   r.allow(root, "",
-          {"name", "geometry", "mesh", "materials", "boundary", "loads", "solver", "output", "dynamics", "contact"});
+          {"name", "geometry", "mesh", "materials", "boundary", "loads", "solver", "output", "dynamics", "contact",
+           "actuation"});
   Scene scene;
   scene.source = path;
   if (root["name"]) scene.name = r.text(root["name"], "name");
@@ -363,6 +365,51 @@ Scene read_scene(const std::string& path) {
         region.mu_static = coefficient(ms, "contact.friction.regions.mu_static");
         region.mu_kinetic = coefficient(mk, "contact.friction.regions.mu_kinetic");
         scene.friction_spec.regions.push_back(region);
+      }
+    }
+  }
+
+  if (const auto a = root["actuation"]) {
+    const std::string key = "actuation";
+    r.allow(a, key, {"schedule", "start", "bladders", "core", "volume_axes", "feet"});
+    if (!a["schedule"]) r.fail(a, key, "missing key 'schedule' (a schedule file)");
+    std::filesystem::path file = r.text(a["schedule"], key + ".schedule");
+    if (file.is_relative()) file = std::filesystem::path(path).parent_path() / file;
+    scene.schedule_file = file.string();
+    const Schedule schedule = read_schedule(scene.schedule_file);  // its own errors name its file and line
+    const double start = a["start"] ? r.number(a["start"], key + ".start") : 0.0;
+    std::array<bool, 3> axes{true, true, true};
+    if (a["volume_axes"]) axes = r.axes(a["volume_axes"], key + ".volume_axes");
+    auto add_cavity = [&](int channel, const std::string& surface) {
+      CavitySpec spec;
+      spec.name = channel_name(channel);
+      spec.surfaces = {surface};
+      spec.axes = axes;
+      spec.pressure = channel_pressure(schedule, channel, start);
+      scene.cavities.push_back(spec);
+    };
+    if (const auto b = a["bladders"]) {
+      if (!b.IsMap()) r.fail(b, key + ".bladders", "expected a map {b1: surface, ...}");
+      for (const auto& kv : b) {
+        const std::string name = kv.first.as<std::string>();
+        const int channel = channel_index(name);
+        if (channel < 0 || channel >= kNumBladders)
+          r.fail(kv.first, key + ".bladders." + name, "not a bladder channel (b1..b8)");
+        add_cavity(channel, r.text(kv.second, key + ".bladders." + name));
+      }
+    }
+    if (a["core"]) add_cavity(kChannelCore, r.text(a["core"], key + ".core"));
+    if (const auto f = a["feet"]) {
+      r.allow(f, key + ".feet", {"foot_a", "foot_b", "mu_active", "mu_inactive"});
+      if (!scene.ground_contact) r.fail(f, key + ".feet", "foot friction needs contact.ground");
+      const double mu_active = f["mu_active"] ? r.number(f["mu_active"], key + ".feet.mu_active") : 2.0;
+      const double mu_inactive = f["mu_inactive"] ? r.number(f["mu_inactive"], key + ".feet.mu_inactive") : 1e-4;
+      scene.friction = true;
+      for (const auto& [foot, channel] :
+           {std::pair<const char*, int>{"foot_a", kChannelFootA}, {"foot_b", kChannelFootB}}) {
+        if (!f[foot]) continue;
+        const TimeFunction mu = foot_friction(schedule, channel, start, mu_active, mu_inactive);
+        scene.friction_spec.regions.push_back({r.text(f[foot], key + ".feet." + foot), mu, mu});
       }
     }
   }

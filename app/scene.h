@@ -36,6 +36,11 @@
 //     friction: {eps_v: 1e-4, lag_updates: 0,
 //                regions: [{surface: zmin, mu_static: 0.5, mu_kinetic: 0.4}]}
 //                # mu: a number or a table [[t, mu], ...] (coefficients that change over time)
+//   actuation:                                  # a schedule file shared with `morphfem hw play`
+//     {schedule: schedules/rolling.yaml, start: 1.0,      # gait time 0 at t = start [s]
+//      bladders: {b1: bladder_1_wall, ...},               # channel -> cavity wall surface
+//      core: core_wall, volume_axes: [x, y, z],
+//      feet: {foot_a: foot_a, foot_b: foot_b, mu_active: 2.0, mu_inactive: 1.0e-4}}
 //   output: {directory: results/demo, every: 1}
 #pragma once
 #include <array>
@@ -95,6 +100,7 @@ struct Scene {
   GroundContactSpec ground;
   bool friction = false;
   FrictionSpec friction_spec;
+  std::string schedule_file;  // the actuation schedule, if any (its loads are in cavities/friction)
   SolverOptions solver;
   std::string formulation = "displacement";  // elastic element formulation (fem/elastic.h)
   int quadrature_degree = 0;

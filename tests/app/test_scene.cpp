@@ -203,3 +203,45 @@ output: {directory: OUT}
   EXPECT_NE(text.find("\"status\": \"failed\""), std::string::npos) << text;
   EXPECT_TRUE(fs::exists(s.dir / "out" / "balloon.xdmf"));
 }
+
+// A schedule file drives a cavity: bladder 1 of the rolling schedule (inflated in
+// the 8th column of each repeat) inflates a tube only while the schedule says so.
+TEST(Scene, ScheduleDrivesTheBladderPressure) {
+  const std::string schedule = std::string(MORPHFEM_SOURCE_DIR) + "/examples/schedules/rolling.yaml";
+  TempScene s(R"(name: scheduled_tube
+geometry: {type: thick_cylinder, inner_radius: 0.005, outer_radius: 0.02, mesh_size: 0.004, order: 1}
+materials:
+  body: {model: dragon_skin_10}
+boundary:
+  - {surface: sym_x, fix: [x]}
+  - {surface: sym_y, fix: [y]}
+  - {surface: zmin, fix: [z]}
+  - {surface: zmax, fix: [z]}
+actuation: {schedule: )" +
+              schedule + R"(, start: 0.5, bladders: {b1: inner}, volume_axes: [x, y]}
+solver: {end_time: 10.4, initial_step: 0.3, max_step: 0.3}
+)");
+  Scene scene = read_scene(s.file.string());
+  ASSERT_EQ(scene.cavities.size(), 1u);
+  std::vector<std::pair<double, double>> volume;  // (gait time, volume)
+  RunOptions options{false, false, {}};
+  options.on_step = [&](double t, const Mesh&, const RowMatrixXd&, const SimulationResult& r) {
+    volume.emplace_back(t - 0.5, r.cavity_volume.at(0));
+  };
+  scene.solver.output_times = {0.5 + 3.5 * 1.237, 0.5 + 7.5 * 1.237};
+  auto r = run_scene(scene, PETSC_COMM_WORLD, options);
+  ASSERT_TRUE(r.stats.completed) << r.stats.failure;
+  const double v0 = volume.front().second;
+  int checked = 0;
+  for (const auto& [t, v] : volume) {
+    if (std::abs(t - 3.5 * 1.237) < 1e-9) {
+      EXPECT_NEAR(v, v0, 1e-9 * v0);  // column 4: b1 deflated
+      ++checked;
+    }
+    if (std::abs(t - 7.5 * 1.237) < 1e-9) {
+      EXPECT_GT(v, 1.05 * v0);  // column 8: b1 inflated
+      ++checked;
+    }
+  }
+  EXPECT_EQ(checked, 2);
+}
