@@ -381,6 +381,30 @@ void cantilever_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<Verifi
   }
 }
 
+// A stiff 2 cm block (P1, mu = 10 MPa) on the ground plane z = 0 under gravity
+// g = 9.8 tilted by the slope atan(0.5) (x is downhill), with implicit-Euler
+// inertia, barrier contact started at the resting gap and friction mu(t) on its
+// bottom face; time step dt up to t_end.
+Scene sliding_block_scene(const std::string& name, const TimeFunction& mu, double eps_v, double t_end, double dt) {
+  const double g = 9.8, slope = std::atan(0.5), L = 0.02, dhat = 1e-5;
+  Scene s = verification_scene(
+      name, verification_params({{"lx", L}, {"ly", L}, {"lz", L}, {"mesh_size", L / 2}, {"order", 1}}, "type", "block"),
+      verification_params({{"mu", 1e7}, {"nu", 0.3}, {"density", 1000}}, "model", "neo_hookean"));
+  s.gravity = Eigen::Vector3d(g * std::sin(slope), 0, -g * std::cos(slope));
+  s.dynamic = true;
+  s.inertia.scheme = TimeScheme::implicit_euler;
+  s.ground_contact = true;
+  s.ground.surfaces = {"zmin"};
+  s.ground.dhat = dhat;
+  s.ground.point = Eigen::Vector3d(0, 0, -0.9985 * dhat);  // the resting barrier gap under the weight
+  s.friction = true;
+  s.friction_spec.eps_v = eps_v;  // stick creep ~ eps_v (1 - sqrt(1 - q)) per second, q = load / (mu N)
+  s.friction_spec.regions.push_back({"zmin", mu, mu});
+  s.solver.t_end = t_end;
+  s.solver.dt_initial = s.solver.dt_max = dt;
+  return s;
+}
+
 // -------------------------------------------- case 8: block sliding down a slope
 // Coulomb friction mu = 0.49 on a slope atan(0.5), g = 9.8 (gravity tilted):
 // s(t) = a t^2 / 2, a = g (sin - mu cos) = 0.087654 m/s^2, s(2.5 s) = 0.27392 m.
@@ -389,27 +413,12 @@ void cantilever_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<Verifi
 void slope_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<VerificationRecord>& out) {
   const double g = 9.8, slope = std::atan(0.5), mu = 0.49, T = 2.5;
   const double reference = 0.5 * g * (std::sin(slope) - mu * std::cos(slope)) * T * T;
-  const double L = 0.02, dhat = 1e-5;
+  const double L = 0.02;
   std::vector<double> steps = opt.quick ? std::vector<double>{0.05, 0.025} : std::vector<double>{0.05, 0.025, 0.0125};
   double prev_error = 0, prev_dt = 0;
   for (size_t level = 0; level < steps.size(); ++level) {
     const double dt = steps[level];
-    Scene s = verification_scene(
-        "slope",
-        verification_params({{"lx", L}, {"ly", L}, {"lz", L}, {"mesh_size", L / 2}, {"order", 1}}, "type", "block"),
-        verification_params({{"mu", 1e7}, {"nu", 0.3}, {"density", 1000}}, "model", "neo_hookean"));
-    s.gravity = Eigen::Vector3d(g * std::sin(slope), 0, -g * std::cos(slope));
-    s.dynamic = true;
-    s.inertia.scheme = TimeScheme::implicit_euler;
-    s.ground_contact = true;
-    s.ground.surfaces = {"zmin"};
-    s.ground.dhat = dhat;
-    s.ground.point = Eigen::Vector3d(0, 0, -0.9985 * dhat);  // the resting barrier gap under the weight
-    s.friction = true;
-    s.friction_spec.eps_v = 1e-4;
-    s.friction_spec.regions.push_back({"zmin", TimeFunction::constant(mu), TimeFunction::constant(mu)});
-    s.solver.t_end = T;
-    s.solver.dt_initial = s.solver.dt_max = dt;
+    Scene s = sliding_block_scene("slope", TimeFunction::constant(mu), 1e-4, T, dt);
     auto r = run_scene(s, comm, {false, opt.progress, {}});
     require_completed(r, "block on a slope");
     double slide = 0;
@@ -433,7 +442,7 @@ void slope_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<Verificatio
 // a2 = g (sin - 0.9 cos) < 0 until it stops). Exact slide:
 // s = a1/2 (1 s)^2 + (a1 * 1 s)^2 / (2 |a2|); no motion before t = 1 s.
 void friction_switch_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<VerificationRecord>& out) {
-  const double g = 9.8, slope = std::atan(0.5), L = 0.02, dhat = 1e-5, T = 3.0;
+  const double g = 9.8, slope = std::atan(0.5), L = 0.02, T = 3.0;
   const double a1 = g * (std::sin(slope) - 0.2 * std::cos(slope)), a2 = g * (std::sin(slope) - 0.9 * std::cos(slope));
   const double reference = 0.5 * a1 + a1 * a1 / (2 * std::abs(a2));
   const TimeFunction mu({{0.0, 0.9}, {1.0, 0.9}, {1.0 + 1e-6, 0.2}, {2.0, 0.2}, {2.0 + 1e-6, 0.9}});
@@ -441,22 +450,7 @@ void friction_switch_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<V
   double prev_error = 0, prev_dt = 0;
   for (size_t level = 0; level < steps.size(); ++level) {
     const double dt = steps[level];
-    Scene s = verification_scene(
-        "friction_switch",
-        verification_params({{"lx", L}, {"ly", L}, {"lz", L}, {"mesh_size", L / 2}, {"order", 1}}, "type", "block"),
-        verification_params({{"mu", 1e7}, {"nu", 0.3}, {"density", 1000}}, "model", "neo_hookean"));
-    s.gravity = Eigen::Vector3d(g * std::sin(slope), 0, -g * std::cos(slope));
-    s.dynamic = true;
-    s.inertia.scheme = TimeScheme::implicit_euler;
-    s.ground_contact = true;
-    s.ground.surfaces = {"zmin"};
-    s.ground.dhat = dhat;
-    s.ground.point = Eigen::Vector3d(0, 0, -0.9985 * dhat);
-    s.friction = true;
-    s.friction_spec.eps_v = 1e-5;  // stick creep ~ eps_v (1 - sqrt(1 - q)) per second, q = load / (mu N)
-    s.friction_spec.regions.push_back({"zmin", mu, mu});
-    s.solver.t_end = T;
-    s.solver.dt_initial = s.solver.dt_max = dt;
+    Scene s = sliding_block_scene("friction_switch", mu, 1e-5, T, dt);
     s.solver.output_times = {1.0, 2.0};
     double slide_at_1 = 0;
     RunOptions run{false, opt.progress, {}};
