@@ -287,20 +287,11 @@ SimulationResult run_scene(const Scene& scene, MPI_Comm comm, const RunOptions& 
     // Cell measures: each rank fills its own cells, a reduction gathers them.
     std::vector<double> J(mesh.n_cells(), 0.0), vm(mesh.n_cells(), 0.0), Jg(mesh.n_cells()), vmg(mesh.n_cells());
     double local_min_J = std::numeric_limits<double>::infinity();
-    PieceState s;
-    std::vector<int> nodes;
+    const auto measures = elastic->measures_all(result.u);
     for (int k = 0; k < elastic->n_pieces(); ++k) {
-      elastic->piece_nodes(k, nodes);
-      s.X.resize(nodes.size(), 3);
-      s.u.resize(nodes.size(), 3);
-      for (size_t a = 0; a < nodes.size(); ++a) {
-        s.X.row(a) = mesh.X.row(nodes[a]);
-        s.u.row(a) = result.u.row(nodes[a]);
-      }
-      auto m = elastic->measures(k, s);
-      J[elastic->cell_of_piece(k)] = m.J_mean;
-      vm[elastic->cell_of_piece(k)] = m.von_mises;
-      local_min_J = std::min(local_min_J, m.J_min);
+      J[elastic->cell_of_piece(k)] = measures[k].J_mean;
+      vm[elastic->cell_of_piece(k)] = measures[k].von_mises;
+      local_min_J = std::min(local_min_J, measures[k].J_min);
     }
     MPI_Allreduce(&local_min_J, &result.min_J, 1, MPI_DOUBLE, MPI_MIN, comm);
     const bool output_now = force_write || (step % scene.output_every == 0);

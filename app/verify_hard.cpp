@@ -235,18 +235,7 @@ EndMomentResult run_end_moment(double L, double h, double mesh_size, double mu, 
   for (int n : tip_nodes) out.tip_final += (mesh.X.row(n) + out.run.u.row(n)).transpose() / double(tip_nodes.size());
   // Smallest det F over the cells (volume-averaged and pointwise minimum).
   double local_min_J = std::numeric_limits<double>::infinity();
-  PieceState s;
-  std::vector<int> nodes;
-  for (int k = 0; k < elastic->n_pieces(); ++k) {
-    elastic->piece_nodes(k, nodes);
-    s.X.resize(nodes.size(), 3);
-    s.u.resize(nodes.size(), 3);
-    for (size_t a = 0; a < nodes.size(); ++a) {
-      s.X.row(a) = mesh.X.row(nodes[a]);
-      s.u.row(a) = out.run.u.row(nodes[a]);
-    }
-    local_min_J = std::min(local_min_J, elastic->measures(k, s).J_min);
-  }
+  for (const auto& m : elastic->measures_all(out.run.u)) local_min_J = std::min(local_min_J, m.J_min);
   MPI_Allreduce(&local_min_J, &out.run.min_J, 1, MPI_DOUBLE, MPI_MIN, comm);
   out.run.stats.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return out;

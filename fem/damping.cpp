@@ -11,13 +11,6 @@ namespace morphfem {
 
 namespace {
 
-// dN/dX = dN/dxi J0^-1 at one point; returns det J0 (reference volume factor).
-double reference_gradients(const Eigen::MatrixXd& X, const Eigen::MatrixXd& dN_dxi, Eigen::MatrixXd& dN_dX) {
-  const Eigen::Matrix3d J0 = X.transpose() * dN_dxi;
-  dN_dX = dN_dxi * J0.inverse();
-  return J0.determinant();
-}
-
 Mat3 deviator(const Mat3& A) { return A - A.trace() / 3.0 * Mat3::Identity(); }
 
 }  // namespace
@@ -27,7 +20,7 @@ std::vector<Mat3> green_lagrange_at_points(const ShapeTable& table, const Eigen:
   std::vector<Mat3> E(table.points.size());
   Eigen::MatrixXd dN_dX;
   for (size_t q = 0; q < table.points.size(); ++q) {
-    reference_gradients(X, table.dN[q], dN_dX);
+    physical_gradients(X, table.dN[q], dN_dX);
     const Mat3 F = Mat3::Identity() + u.transpose() * dN_dX;
     E[q] = 0.5 * (F.transpose() * F - Mat3::Identity());
   }
@@ -51,18 +44,14 @@ double viscous_damping_kernel(const ShapeTable& table, const Eigen::MatrixXd& X,
   Eigen::MatrixXd dN_dX, B;
   double energy = 0.0;
   for (size_t q = 0; q < table.points.size(); ++q) {
-    const double dV = table.points[q].weight * reference_gradients(X, table.dN[q], dN_dX);
+    const double dV = table.points[q].weight * physical_gradients(X, table.dN[q], dN_dX);
     const Mat3 F = Mat3::Identity() + u.transpose() * dN_dX;
     const Mat3 dE = 0.5 * (F.transpose() * F - Mat3::Identity()) - E_star[q];
     const double trace = dE.trace();
     energy += dV * (eta / h * deviator(dE).squaredNorm() + 0.5 * b * trace * trace);
     if (!g && !H) continue;
     const Mat3 S = viscous_stress(dE);
-    // B(3i+J, 3c+i) = dF_iJ/du_ci = dN_c/dX_J
-    B.setZero(9, 3 * n);
-    for (int c = 0; c < n; ++c)
-      for (int i = 0; i < 3; ++i)
-        for (int J = 0; J < 3; ++J) B(3 * i + J, 3 * c + i) = dN_dX(c, J);
+    deformation_gradient_map(dN_dX, B);  // dF/du
     if (g) *g += dV * B.transpose() * flatten(F * S);
     if (H) {
       Tangent A;
@@ -179,7 +168,7 @@ void DampingTerm::end_step(Assembler& assembler, Vec u1, double /*t1*/) {
       // Viscous stress of the rate that does the work: S_v(Edot) = 2 eta dev Edot + zeta tr(Edot) I.
       const Mat3 rate = trapezoidal_ ? Mat3(0.5 * (Edot_n_[k][q] + Edot1[q])) : Edot1[q];
       const Mat3 S = 2 * eta_[k] * deviator(rate) + zeta_[k] * rate.trace() * Mat3::Identity();
-      const double dV = table_.points[q].weight * reference_gradients(X, table_.dN[q], dN_dX);
+      const double dV = table_.points[q].weight * physical_gradients(X, table_.dN[q], dN_dX);
       sum += dV * (S.array() * (E1[q] - E_n_[k][q]).array()).sum();
     }
     Edot_n_[k] = std::move(Edot1);

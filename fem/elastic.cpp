@@ -26,17 +26,6 @@ void ElasticTerm::piece_nodes(int k, std::vector<int>& nodes) const {
   nodes.assign(mesh_.cells.row(c).data(), mesh_.cells.row(c).data() + mesh_.nodes_per_cell());
 }
 
-namespace {
-// Reference-to-physical gradients at one quadrature point:
-//   J0 = dX/dxi (3x3), dN/dX = dN/dxi J0^-1, returns det J0 (> 0 for a valid mesh).
-double physical_gradients(const Eigen::MatrixXd& X, const Eigen::MatrixXd& dN_dxi, Eigen::MatrixXd& dN_dX) {
-  Eigen::Matrix3d J0 = X.transpose() * dN_dxi;  // J0(i,k) = sum_a X_ai dN_a/dxi_k
-  const double det = J0.determinant();
-  dN_dX = dN_dxi * J0.inverse();
-  return det;
-}
-}  // namespace
-
 double ElasticTerm::piece(int k, const PieceState& s, Eigen::VectorXd* g, Eigen::MatrixXd* H) const {
   const Material& material = *materials_[mesh_.cell_region[cells_[k]]];
   const int n = static_cast<int>(s.X.rows());
@@ -58,11 +47,7 @@ double ElasticTerm::piece(int k, const PieceState& s, Eigen::VectorXd* g, Eigen:
     double W;
     material.evaluate(F, W, P, H ? &A : nullptr);
     energy += dV * W;
-    // B(3i+J, 3b+k) = dF_iJ / du_bk = delta_ik dN_b/dX_J
-    B.setZero(9, 3 * n);
-    for (int b = 0; b < n; ++b)
-      for (int i = 0; i < 3; ++i)
-        for (int J = 0; J < 3; ++J) B(3 * i + J, 3 * b + i) = dN_dX(b, J);
+    deformation_gradient_map(dN_dX, B);
     if (g) {
       const Eigen::Matrix<double, 3, 3, Eigen::RowMajor> P_rows = P;  // flatten as 3*i + J
       *g += dV * B.transpose() * Eigen::Map<const Eigen::Matrix<double, 9, 1>>(P_rows.data());
@@ -95,6 +80,24 @@ ElasticTerm::CellMeasures ElasticTerm::measures(int k, const PieceState& s) cons
     J_min = std::min(J_min, J);
   }
   return {J_sum / volume, J_min, vm_sum / volume};
+}
+
+std::vector<ElasticTerm::CellMeasures> ElasticTerm::measures_all(const RowMatrixXd& u) const {
+  std::vector<CellMeasures> out;
+  out.reserve(cells_.size());
+  PieceState s;
+  std::vector<int> nodes;
+  for (int k = 0; k < n_pieces(); ++k) {
+    piece_nodes(k, nodes);
+    s.X.resize(nodes.size(), 3);
+    s.u.resize(nodes.size(), 3);
+    for (size_t a = 0; a < nodes.size(); ++a) {
+      s.X.row(a) = mesh_.X.row(nodes[a]);
+      s.u.row(a) = u.row(nodes[a]);
+    }
+    out.push_back(measures(k, s));
+  }
+  return out;
 }
 
 const std::map<std::string, ElasticTermFactory>& elastic_formulations() {

@@ -34,6 +34,9 @@ class ElasticTerm : public EnergyTerm {
     double J_mean, J_min, von_mises;
   };
   CellMeasures measures(int k, const PieceState& s) const;
+  // measures() of every owned cell (in piece order) for a full displacement
+  // field u (n_nodes x 3).
+  std::vector<CellMeasures> measures_all(const RowMatrixXd& u) const;
   int cell_of_piece(int k) const { return cells_[k]; }
 
  protected:

@@ -125,4 +125,18 @@ ShapeTable make_triangle_table(int order, int degree) {
   return make_table(order, triangle_quadrature(degree), triangle_shape);
 }
 
+double physical_gradients(const Eigen::MatrixXd& X, const Eigen::MatrixXd& dN_dxi, Eigen::MatrixXd& dN_dX) {
+  const Eigen::Matrix3d J0 = X.transpose() * dN_dxi;  // J0(i,k) = sum_a X_ai dN_a/dxi_k
+  dN_dX = dN_dxi * J0.inverse();
+  return J0.determinant();
+}
+
+void deformation_gradient_map(const Eigen::MatrixXd& dN_dX, Eigen::MatrixXd& B) {
+  const int n = static_cast<int>(dN_dX.rows());
+  B.setZero(9, 3 * n);
+  for (int b = 0; b < n; ++b)
+    for (int i = 0; i < 3; ++i)
+      for (int J = 0; J < 3; ++J) B(3 * i + J, 3 * b + i) = dN_dX(b, J);
+}
+
 }  // namespace morphfem

@@ -35,6 +35,16 @@ struct ShapeTable {
   std::vector<Eigen::MatrixXd> dN;  // per point: n x dim (reference gradients)
 };
 ShapeTable make_tet_table(int order, int degree);
+
+// Reference-to-physical gradients at one point of a cell with nodal reference
+// coordinates X (n x 3): J0 = X^T dN/dxi (3x3), dN/dX = dN/dxi J0^-1 (n x 3).
+// Returns det J0, the reference volume per unit reference-simplex volume (> 0 for
+// a valid mesh).
+double physical_gradients(const Eigen::MatrixXd& X, const Eigen::MatrixXd& dN_dxi, Eigen::MatrixXd& dN_dX);
+
+// The linear map from nodal displacements to the deformation gradient:
+// B(3i+J, 3b+k) = dF_iJ / du_bk = delta_ik dN_b/dX_J (9 x 3n, F flattened row-major).
+void deformation_gradient_map(const Eigen::MatrixXd& dN_dX, Eigen::MatrixXd& B);
 ShapeTable make_triangle_table(int order, int degree);
 
 }  // namespace morphfem

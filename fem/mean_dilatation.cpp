@@ -11,13 +11,6 @@ namespace morphfem {
 
 namespace {
 
-// dN/dX = dN/dxi J0^-1 with J0 = dX/dxi; returns det J0 (> 0 for a valid mesh).
-double reference_gradients(const Eigen::MatrixXd& X, const Eigen::MatrixXd& dN_dxi, Eigen::MatrixXd& dN_dX) {
-  const Eigen::Matrix3d J0 = X.transpose() * dN_dxi;
-  dN_dX = dN_dxi * J0.inverse();
-  return J0.determinant();
-}
-
 int isochoric_degree(int quadrature_degree) { return quadrature_degree > 0 ? quadrature_degree : 2; }
 
 }  // namespace
@@ -38,7 +31,7 @@ void MeanDilatationTerm::dilatation(const PieceState& s, double& reference_volum
   Eigen::MatrixXd dN_dX;
   double V = 0.0, v = 0.0;
   for (size_t q = 0; q < volume_table_.points.size(); ++q) {
-    const double dV = volume_table_.points[q].weight * reference_gradients(s.X, volume_table_.dN[q], dN_dX);
+    const double dV = volume_table_.points[q].weight * physical_gradients(s.X, volume_table_.dN[q], dN_dX);
     const Mat3 F = Mat3::Identity() + s.u.transpose() * dN_dX;
     V += dV;
     v += dV * F.determinant();
@@ -60,18 +53,14 @@ double MeanDilatationTerm::piece(int k, const PieceState& s, Eigen::VectorXd* g,
 
   // ---- Isochoric part: int_e W_iso(F) dV.
   for (size_t q = 0; q < table_.points.size(); ++q) {
-    const double dV = table_.points[q].weight * reference_gradients(s.X, table_.dN[q], dN_dX);
+    const double dV = table_.points[q].weight * physical_gradients(s.X, table_.dN[q], dN_dX);
     const Mat3 F = Mat3::Identity() + s.u.transpose() * dN_dX;
     if (!(F.determinant() > 0.0)) return inf;
     double W;
     material.evaluate_isochoric(F, W, P, H ? &A : nullptr);
     energy += dV * W;
     if (!g && !H) continue;
-    // B(3i+J, 3b+k) = dF_iJ / du_bk = delta_ik dN_b/dX_J
-    B.setZero(9, 3 * n);
-    for (int b = 0; b < n; ++b)
-      for (int i = 0; i < 3; ++i)
-        for (int J = 0; J < 3; ++J) B(3 * i + J, 3 * b + i) = dN_dX(b, J);
+    deformation_gradient_map(dN_dX, B);
     if (g) {
       const Eigen::Matrix<double, 3, 3, Eigen::RowMajor> P_rows = P;  // flattened as 3*i + J
       *g += dV * B.transpose() * Eigen::Map<const Eigen::Matrix<double, 9, 1>>(P_rows.data());
@@ -87,7 +76,7 @@ double MeanDilatationTerm::piece(int k, const PieceState& s, Eigen::VectorXd* g,
   if (H) d2v.setZero(3 * n, 3 * n);
   Eigen::MatrixXd grad_x;  // spatial gradients g_ai = (dN/dX F^-1)_ai  [1/m]
   for (size_t q = 0; q < volume_table_.points.size(); ++q) {
-    const double dV = volume_table_.points[q].weight * reference_gradients(s.X, volume_table_.dN[q], dN_dX);
+    const double dV = volume_table_.points[q].weight * physical_gradients(s.X, volume_table_.dN[q], dN_dX);
     const Mat3 F = Mat3::Identity() + s.u.transpose() * dN_dX;
     const double J = F.determinant();
     if (!(J > 0.0)) return inf;

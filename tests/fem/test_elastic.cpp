@@ -8,6 +8,7 @@
 #include "fem/element.h"
 #include "fem/loads.h"
 #include "fem/material.h"
+#include "tests/support/finite_differences.h"
 
 using namespace morphfem;
 
@@ -117,19 +118,9 @@ TEST_P(ElasticFD, GradientAndHessianMatchFiniteDifferences) {
   Eigen::VectorXd g;
   Eigen::MatrixXd H;
   term.piece(0, s, &g, &H);
-  const double eps = 1e-7;
-  Eigen::VectorXd g_fd(g.size());
-  Eigen::MatrixXd H_fd(H.rows(), H.cols());
-  for (int j = 0; j < g.size(); ++j) {
-    PieceState plus = s, minus = s;
-    plus.u(j / 3, j % 3) += eps;
-    minus.u(j / 3, j % 3) -= eps;
-    g_fd[j] = (term.piece(0, plus, nullptr, nullptr) - term.piece(0, minus, nullptr, nullptr)) / (2 * eps);
-    Eigen::VectorXd gp, gm;
-    term.piece(0, plus, &gp, nullptr);
-    term.piece(0, minus, &gm, nullptr);
-    H_fd.col(j) = (gp - gm) / (2 * eps);
-  }
+  Eigen::VectorXd g_fd;
+  Eigen::MatrixXd H_fd;
+  morphfem::testing::piece_finite_differences(term, 0, s, 1e-7, g_fd, H_fd);
   EXPECT_LT((g - g_fd).norm(), 1e-6 * g.norm());
   EXPECT_LT((H - H_fd).norm(), 1e-6 * H.norm());
   EXPECT_LT((H - H.transpose()).norm(), 1e-10 * H.norm());

@@ -7,6 +7,7 @@
 #include <random>
 
 #include "fem/end_moment.h"
+#include "tests/support/finite_differences.h"
 
 using namespace morphfem;
 
@@ -115,19 +116,9 @@ TEST(EndMoment, GradientAndHessianMatchFiniteDifferences) {
     Eigen::VectorXd g;
     Eigen::MatrixXd H;
     term.piece(0, p, &g, &H);
-    const double eps = 1e-8;
-    Eigen::VectorXd g_fd(g.size());
-    Eigen::MatrixXd H_fd(H.rows(), H.cols());
-    for (int j = 0; j < g.size(); ++j) {
-      PieceState plus = p, minus = p;
-      plus.u(j / 3, j % 3) += eps;
-      minus.u(j / 3, j % 3) -= eps;
-      g_fd[j] = (term.piece(0, plus, nullptr, nullptr) - term.piece(0, minus, nullptr, nullptr)) / (2 * eps);
-      Eigen::VectorXd gp, gm;
-      term.piece(0, plus, &gp, nullptr);
-      term.piece(0, minus, &gm, nullptr);
-      H_fd.col(j) = (gp - gm) / (2 * eps);
-    }
+    Eigen::VectorXd g_fd;
+    Eigen::MatrixXd H_fd;
+    morphfem::testing::piece_finite_differences(term, 0, p, 1e-8, g_fd, H_fd);
     EXPECT_LT((g - g_fd).norm(), 1e-6 * g.norm()) << "phi " << phi;
     EXPECT_LT((H - H_fd).norm(), 1e-6 * H.norm()) << "phi " << phi;
     EXPECT_LT((H - H.transpose()).norm(), 1e-12 * H.norm());
