@@ -81,6 +81,7 @@ class CavityVolumeTerm : public EnergyTerm {
   virtual double energy_second_derivative(double V) const = 0;
 
  protected:
+  double meshed_volume(const Assembler& assembler, const std::vector<double>& u_local) const;
   double face_volume(int k, const Eigen::MatrixXd& x, Eigen::VectorXd* g, Eigen::MatrixXd* H) const;
   double model_volume_at(Assembler& assembler, Vec u) const;  // collective
 
