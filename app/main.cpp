@@ -16,7 +16,9 @@
 #include <string>
 #include <vector>
 
+#include "app/calibrate_cli.h"
 #include "app/scene.h"
+#include "app/search_cli.h"
 #include "app/simulation.h"
 #include "app/verify.h"
 #include "core/errors.h"
@@ -35,6 +37,8 @@ const char* kUsage =
     "                               error against the reference beside wall time\n"
     "  fit-materials [--data-dir DIR] [--max-strain S] [--json]\n"
     "                               fit hyperelastic laws to uniaxial test exports\n"
+    "  search ...                   hill-climbing experiments (morphfem search --help)\n"
+    "  calibrate ...                friction, material and morphing calibration (morphfem calibrate --help)\n"
     "  hw emulate|play|check ...    pneumatic regulators (see hardware/README.md)\n";
 
 int rank_of_world() {
@@ -134,14 +138,21 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "morphfem: error: %s\n", e.what());
     return 2;
   }
-  if (command != "run" && command != "verify") {
+  if (command != "run" && command != "verify" && command != "search" && command != "calibrate") {
     std::fprintf(stderr, "morphfem: unknown command '%s'\n%s", command.c_str(), kUsage);
     return 2;
   }
   if (PetscInitialize(&argc, &argv, nullptr, nullptr)) return 1;
   int status = 0;
   try {
-    status = command == "run" ? cmd_run(rest) : cmd_verify(rest);
+    if (command == "run")
+      status = cmd_run(rest);
+    else if (command == "verify")
+      status = cmd_verify(rest);
+    else if (command == "search")
+      status = morphfem::search_main(rest, PETSC_COMM_WORLD);
+    else
+      status = morphfem::calibrate_main(rest, PETSC_COMM_WORLD);
   } catch (const morphfem::InputError& e) {
     if (rank_of_world() == 0) std::fprintf(stderr, "morphfem: error: %s\n", e.what());
     status = 2;

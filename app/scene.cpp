@@ -2,10 +2,13 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <cmath>
 #include <filesystem>
+#include <optional>
 #include <set>
 
 #include "actuation/schedule_loads.h"
+#include "actuation/voxel_growth.h"
 #include "core/errors.h"
 #include "fem/elastic.h"
 
@@ -125,7 +128,7 @@ Scene read_scene(const std::string& path) {
   if (!root.IsMap()) throw InputError(path, "a scene must be a mapping with keys geometry/mesh, materials, ...");
   r.allow(root, "",
           {"name", "geometry", "mesh", "materials", "boundary", "loads", "solver", "output", "dynamics", "contact",
-           "actuation"});
+           "actuation", "environment"});
   Scene scene;
   scene.source = path;
   if (root["name"]) scene.name = r.text(root["name"], "name");
@@ -223,7 +226,7 @@ Scene read_scene(const std::string& path) {
   }
 
   if (const auto l = root["loads"]) {
-    r.allow(l, "loads", {"gravity", "cavities", "gas_cavities", "tractions"});
+    r.allow(l, "loads", {"gravity", "cavities", "gas_cavities", "tractions", "pulls"});
     if (l["gravity"]) scene.gravity = r.vector3(l["gravity"], "loads.gravity");
     if (const auto cs = l["cavities"]) {
       if (!cs.IsSequence()) r.fail(cs, "loads.cavities", "expected a list");
@@ -288,6 +291,23 @@ Scene read_scene(const std::string& path) {
         scene.tractions.push_back(spec);
       }
     }
+    if (const auto ps = l["pulls"]) {  // test-machine pull springs (fem/pull_spring.h)
+      if (!ps.IsSequence()) r.fail(ps, "loads.pulls", "expected a list");
+      for (const auto& p : ps) {
+        r.allow(p, "loads.pulls", {"surface", "stiffness", "velocity", "start"});
+        if (!p["surface"] || !p["stiffness"] || !p["velocity"])
+          r.fail(p, "loads.pulls", "needs 'surface', 'stiffness' [N/m] and 'velocity' [m/s]");
+        PullSpringSpec spec;
+        spec.surface = r.text(p["surface"], "loads.pulls.surface");
+        spec.stiffness = r.number(p["stiffness"], "loads.pulls.stiffness");
+        if (!(spec.stiffness > 0)) r.fail(p["stiffness"], "loads.pulls.stiffness", "must be > 0 [N/m]");
+        spec.velocity = r.vector3(p["velocity"], "loads.pulls.velocity");
+        if (!(spec.velocity.norm() > 0)) r.fail(p["velocity"], "loads.pulls.velocity", "must not be zero [m/s]");
+        if (p["start"]) spec.start = r.number(p["start"], "loads.pulls.start");
+        spec.where = r.at(p);
+        scene.pulls.push_back(spec);
+      }
+    }
   }
 
   if (const auto d = root["dynamics"]) {
@@ -322,7 +342,7 @@ Scene read_scene(const std::string& path) {
   }
 
   if (const auto c = root["contact"]) {
-    r.allow(c, "contact", {"ground", "friction"});
+    r.allow(c, "contact", {"ground", "friction", "self"});
     if (const auto g = c["ground"]) {
       r.allow(g, "contact.ground", {"point", "normal", "surfaces", "dhat", "kappa"});
       scene.ground_contact = true;
@@ -367,17 +387,68 @@ Scene read_scene(const std::string& path) {
         scene.friction_spec.regions.push_back(region);
       }
     }
+    if (const auto sc = c["self"]) {
+      r.allow(sc, "contact.self", {"pairs", "dhat", "kappa", "inflation"});
+      scene.self_contact = true;
+      const YAML::Node pairs = sc["pairs"];
+      if (!pairs || !pairs.IsSequence() || pairs.size() == 0)
+        r.fail(pairs ? pairs : sc, "contact.self.pairs", "expected a list of surface pairs [[surf_a, surf_b], ...]");
+      for (const auto& pair : pairs) {
+        if (!pair.IsSequence() || pair.size() != 2)
+          r.fail(pair, "contact.self.pairs", "each pair must be [surf_a, surf_b] (the same name twice: within one)");
+        scene.self_contact_spec.pairs.emplace_back(r.text(pair[0], "contact.self.pairs"),
+                                                   r.text(pair[1], "contact.self.pairs"));
+      }
+      // dhat [m], kappa [Pa], inflation [m]: 0 or absent selects the default.
+      for (auto [key, value] :
+           {std::pair{"dhat", &scene.self_contact_spec.dhat}, std::pair{"kappa", &scene.self_contact_spec.kappa},
+            std::pair{"inflation", &scene.self_contact_spec.inflation}}) {
+        if (!sc[key]) continue;
+        *value = r.number(sc[key], std::string("contact.self.") + key);
+        if (!(*value >= 0)) r.fail(sc[key], std::string("contact.self.") + key, "must not be negative");
+      }
+    }
   }
 
+  std::optional<Schedule> schedule;
   if (const auto a = root["actuation"]) {
     const std::string key = "actuation";
-    r.allow(a, key, {"schedule", "start", "bladders", "core", "volume_axes", "feet"});
+    r.allow(a, key,
+            {"schedule", "start", "bladders", "growth", "timing", "core", "core_ramp_s", "volume_axes", "feet"});
     if (!a["schedule"]) r.fail(a, key, "missing key 'schedule' (a schedule file)");
     std::filesystem::path file = r.text(a["schedule"], key + ".schedule");
     if (file.is_relative()) file = std::filesystem::path(path).parent_path() / file;
     scene.schedule_file = file.string();
-    const Schedule schedule = read_schedule(scene.schedule_file);  // its own errors name its file and line
+    schedule = read_schedule(scene.schedule_file);  // its own errors name its file and line
     const double start = a["start"] ? r.number(a["start"], key + ".start") : 0.0;
+    if (start < 0) r.fail(a["start"], key + ".start", "must be >= 0");
+    if (a["growth"] && a["bladders"]) r.fail(a["growth"], key + ".growth", "give either bladders or growth, not both");
+    std::string timing = a["growth"] ? "voxel" : "schedule";
+    if (a["timing"]) {
+      timing = r.text(a["timing"], key + ".timing");
+      if (timing != "schedule" && timing != "voxel") r.fail(a["timing"], key + ".timing", "must be schedule or voxel");
+      if (a["growth"] && timing != "voxel")
+        r.fail(a["timing"], key + ".timing", "growth actuation runs on the voxel timing");
+    }
+    const VoxelActuation voxel;
+    const double gait_s = timing == "voxel" ? voxel_timeline(*schedule, voxel).duration() : schedule->duration();
+    scene.gait.enabled = true;
+    scene.gait.start = start;
+    scene.gait.end = start + gait_s;
+    scene.gait.nominal_s = schedule->duration();
+    // A run shorter than the gait plays only part of the schedule; its summary then
+    // says gait_complete: false and reports no speed.
+    if (const auto g = a["growth"]) {
+      if (!g.IsMap()) r.fail(g, key + ".growth", "expected a map {b1: volume region, ...}");
+      for (const auto& kv : g) {
+        const std::string name = kv.first.as<std::string>();
+        const int channel = channel_index(name);
+        if (channel < 0 || channel >= kNumBladders)
+          r.fail(kv.first, key + ".growth." + name, "not a bladder channel (b1..b8)");
+        scene.growth.emplace_back(r.text(kv.second, key + ".growth." + name),
+                                  voxel_bladder_growth(*schedule, channel, start, schedule->core_pressure_pa, voxel));
+      }
+    }
     std::array<bool, 3> axes{true, true, true};
     if (a["volume_axes"]) axes = r.axes(a["volume_axes"], key + ".volume_axes");
     auto add_cavity = [&](int channel, const std::string& surface) {
@@ -385,7 +456,7 @@ Scene read_scene(const std::string& path) {
       spec.name = channel_name(channel);
       spec.surfaces = {surface};
       spec.axes = axes;
-      spec.pressure = channel_pressure(schedule, channel, start);
+      spec.pressure = channel_pressure(*schedule, channel, start);
       scene.cavities.push_back(spec);
     };
     if (const auto b = a["bladders"]) {
@@ -398,7 +469,16 @@ Scene read_scene(const std::string& path) {
         add_cavity(channel, r.text(kv.second, key + ".bladders." + name));
       }
     }
-    if (a["core"]) add_cavity(kChannelCore, r.text(a["core"], key + ".core"));
+    if (a["core"]) {
+      add_cavity(kChannelCore, r.text(a["core"], key + ".core"));
+      if (a["core_ramp_s"]) {  // the core rises linearly from 0 over [0, core_ramp_s], then holds
+        const double ramp = r.number(a["core_ramp_s"], key + ".core_ramp_s");
+        if (!(ramp > 0) || ramp > start) r.fail(a["core_ramp_s"], key + ".core_ramp_s", "must be in (0, start]");
+        scene.cavities.back().pressure = TimeFunction::ramp(schedule->core_pressure_pa, ramp);
+      }
+    } else if (a["core_ramp_s"]) {
+      r.fail(a["core_ramp_s"], key + ".core_ramp_s", "needs 'core'");
+    }
     if (const auto f = a["feet"]) {
       r.allow(f, key + ".feet", {"foot_a", "foot_b", "mu_active", "mu_inactive"});
       if (!scene.ground_contact) r.fail(f, key + ".feet", "foot friction needs contact.ground");
@@ -408,11 +488,37 @@ Scene read_scene(const std::string& path) {
       for (const auto& [foot, channel] :
            {std::pair<const char*, int>{"foot_a", kChannelFootA}, {"foot_b", kChannelFootB}}) {
         if (!f[foot]) continue;
-        const TimeFunction mu = foot_friction(schedule, channel, start, mu_active, mu_inactive);
+        const TimeFunction mu = timing == "voxel"
+                                    ? voxel_foot_friction(*schedule, channel, start, mu_active, mu_inactive, voxel)
+                                    : foot_friction(*schedule, channel, start, mu_active, mu_inactive);
         scene.friction_spec.regions.push_back({r.text(f[foot], key + ".feet." + foot), mu, mu});
       }
     }
   }
+
+  if (const auto e = root["environment"]) {
+    const std::string key = "environment";
+    r.allow(e, key, {"slope_deg", "heading_deg", "gravity", "body_length"});
+    if (root["loads"] && root["loads"]["gravity"])
+      r.fail(e, key, "give gravity either in loads.gravity or through environment, not both");
+    const double slope = e["slope_deg"] ? r.number(e["slope_deg"], key + ".slope_deg") : 0.0;
+    if (slope < -90 || slope > 90) r.fail(e["slope_deg"], key + ".slope_deg", "must be in [-90, 90]");
+    double heading = schedule ? schedule->orientation_deg : 0.0;
+    if (e["heading_deg"]) heading = r.number(e["heading_deg"], key + ".heading_deg");
+    const double g = e["gravity"] ? r.number(e["gravity"], key + ".gravity") : 9.80665;
+    if (!(g >= 0)) r.fail(e["gravity"], key + ".gravity", "must be >= 0 [m/s^2]");
+    const double deg = M_PI / 180.0, s_ = slope * deg, h = heading * deg;
+    // The voxel study's rotated gravity: uphill along the heading (cos h, sin h, 0).
+    scene.gravity = g * Eigen::Vector3d(-std::sin(s_) * std::cos(h), -std::sin(s_) * std::sin(h), -std::cos(s_));
+    scene.gait.heading = Eigen::Vector3d(std::cos(h), std::sin(h), 0.0);
+    if (e["body_length"]) {
+      scene.gait.body_length = r.number(e["body_length"], key + ".body_length");
+      if (!(scene.gait.body_length > 0)) r.fail(e["body_length"], key + ".body_length", "must be positive [m]");
+    }
+  }
+  if (scene.gait.enabled)
+    for (double t : {scene.gait.start, scene.gait.end})
+      if (t <= scene.solver.t_end) scene.solver.output_times.push_back(t);
 
   if (scene.friction && scene.dynamic && scene.inertia.scheme != TimeScheme::implicit_euler)
     throw InputError(r.at(root["dynamics"]),

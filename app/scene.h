@@ -24,6 +24,8 @@
 //         # supply_pressure / conductance: a number (constant) or a table [[t, v], ...]
 //     tractions:
 //       - {surface: tip, traction: [0, 0, -100]}  # dead load [Pa], ramped like pressure
+//     pulls:                                    # test machine pulling a region through a spring
+//       - {surface: foot, stiffness: 2000, velocity: [1.667e-3, 0, 0], start: 0}   # N/m, m/s, s
 //   solver: {end_time: 1, initial_step: 0.1, min_step: 1e-6, max_step: 1,
 //            linear_solver: mumps|gamg, quadrature_degree: 0, max_newton_its: 30,
 //            formulation: displacement}
@@ -36,11 +38,26 @@
 //     friction: {eps_v: 1e-4, lag_updates: 0,
 //                regions: [{surface: zmin, mu_static: 0.5, mu_kinetic: 0.4}]}
 //                # mu: a number or a table [[t, mu], ...] (coefficients that change over time)
+//     self: {pairs: [[cavity_top, cavity_bottom]], dhat: 0, kappa: 0, inflation: 0}
+//           # surfaces that may touch (a name twice: within one surface); 0: defaults
+//           # (contact/self_contact.h: dhat 1e-3 x box diagonal, kappa 3 mu, inflation 20 dhat)
 //   actuation:                                  # a schedule file shared with `morphfem hw play`
 //     {schedule: schedules/rolling.yaml, start: 1.0,      # gait time 0 at t = start [s]
 //      bladders: {b1: bladder_1_wall, ...},               # channel -> cavity wall surface
 //      core: core_wall, volume_axes: [x, y, z],
 //      feet: {foot_a: foot_a, foot_b: foot_b, mu_active: 2.0, mu_inactive: 1.0e-4}}
+//     # or, instead of bladder cavities, the voxel study's growth actuation
+//     # (actuation/voxel_growth.h): channel -> bladder volume region, voxel timing
+//     {schedule: ..., start: 1.5, growth: {b1: bladder_1, ...}, core: core_wall,
+//      core_ramp_s: 1.0, feet: {...}}
+//     # timing: schedule (columns of column_s) or voxel (the lattice's column
+//     # lengths: actuation phase + settle with every foot active); growth implies voxel.
+//   environment:                                # the study's ground: gravity rotated
+//     {slope_deg: 15, heading_deg: 90,          # heading default: the schedule's orientation
+//      gravity: 9.80665, body_length: 0.22}     # m/s^2; m (default: the mesh's y extent)
+//     # g = |g| (-sin s cos h, -sin s sin h, -cos s): uphill is the heading (cos h, sin h, 0).
+//     # With an actuation schedule the run reports the gait: displacement of the mean
+//     # node position along the heading from `start` to the end of the gait, in BL/s.
 //   output: {directory: results/demo, every: 1}
 #pragma once
 #include <array>
@@ -53,8 +70,10 @@
 #include "actuation/gas_cavity.h"
 #include "contact/friction.h"
 #include "contact/ground.h"
+#include "contact/self_contact.h"
 #include "core/params.h"
 #include "fem/inertia.h"
+#include "fem/pull_spring.h"
 #include "fem/solver.h"
 
 namespace morphfem {
@@ -75,6 +94,15 @@ struct TractionSpec {
   std::string where;
 };
 
+// The gait measurement of a scene that plays a schedule (see `environment`).
+struct GaitSpec {
+  bool enabled = false;
+  double start = 0.0, end = 0.0;  // simulation times of the gait's first column and its end [s]
+  double nominal_s = 0.0;         // the schedule's nominal duration (speeds divide by it, as the study) [s]
+  Eigen::Vector3d heading = Eigen::Vector3d::UnitX();
+  double body_length = 0.0;  // [m]; <= 0: the mesh's extent along y
+};
+
 struct Scene {
   std::string name = "scene";
   std::string source;                         // file the scene came from ("" if built in code)
@@ -86,6 +114,7 @@ struct Scene {
   std::vector<CavitySpec> cavities;
   std::vector<GasCavitySpec> gas_cavities;
   std::vector<TractionSpec> tractions;
+  std::vector<PullSpringSpec> pulls;  // fem/pull_spring.h; force in tables "pulls" and summary.json
   // Code-built scenes only: a body force b(X, t) [N/m^3] on every cell (e.g. a
   // manufactured solution's load), integrated with `body_force_degree`.
   std::function<Eigen::Vector3d(const Eigen::Vector3d& X, double t)> body_force;
@@ -100,7 +129,12 @@ struct Scene {
   GroundContactSpec ground;
   bool friction = false;
   FrictionSpec friction_spec;
+  bool self_contact = false;  // self-contact between declared surface pairs
+  SelfContactSpec self_contact_spec;
   std::string schedule_file;  // the actuation schedule, if any (its loads are in cavities/friction)
+  // Prescribed growth (active strain) of volume regions: stretches (g_x, g_y, g_z)(t).
+  std::vector<std::pair<std::string, std::function<Eigen::Vector3d(double)>>> growth;
+  GaitSpec gait;
   SolverOptions solver;
   std::string formulation = "displacement";  // elastic element formulation (fem/elastic.h)
   int quadrature_degree = 0;

@@ -4,12 +4,15 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <limits>
+#include <stdexcept>
 
 #include "actuation/cavity.h"
 #include "contact/friction.h"
 #include "contact/ground.h"
+#include "contact/self_contact.h"
 #include "core/errors.h"
 #include "core/json.h"
 #include "core/progress.h"
@@ -19,6 +22,7 @@
 #include "fem/loads.h"
 #include "fem/material.h"
 #include "fem/output.h"
+#include "fem/pull_spring.h"
 #include "mesh/geometry.h"
 
 namespace morphfem {
@@ -118,6 +122,7 @@ Mesh build_scene_mesh(const Scene& scene, MPI_Comm comm) {
   for (const auto& c : scene.cavities)
     for (const auto& s : c.surfaces) require_surface(scene, mesh, s, "", "loads.cavities." + c.name);
   for (const auto& t : scene.tractions) require_surface(scene, mesh, t.surface, t.where, "loads.tractions");
+  for (const auto& p : scene.pulls) require_surface(scene, mesh, p.surface, p.where, "loads.pulls");
   for (const auto& c : scene.gas_cavities)
     for (const auto& s : c.wall.surfaces) require_surface(scene, mesh, s, "", "loads.gas_cavities." + c.wall.name);
   if (scene.ground_contact)
@@ -126,6 +131,9 @@ Mesh build_scene_mesh(const Scene& scene, MPI_Comm comm) {
   if (scene.friction)
     for (const auto& region : scene.friction_spec.regions)
       require_surface(scene, mesh, region.surface, "", "contact.friction.regions");
+  if (scene.self_contact)
+    for (const auto& [first, second] : scene.self_contact_spec.pairs)
+      for (const auto& surface : {first, second}) require_surface(scene, mesh, surface, "", "contact.self.pairs");
   return mesh;
 }
 
@@ -155,6 +163,15 @@ SimulationResult run_scene(const Scene& scene, MPI_Comm comm, const RunOptions& 
   if (formulation == elastic_formulations().end())
     throw InputError(scene_key(scene, "", "solver.formulation"), "unknown formulation '" + scene.formulation + "'");
   auto elastic = formulation->second(mesh, partition, rank, materials, scene.quadrature_degree);
+  for (const auto& [region, stretch] : scene.growth) {
+    if (!mesh.has_region(region, 3))
+      throw InputError(scene_key(scene, "", "actuation.growth"), "the mesh has no volume region '" + region + "'");
+    try {
+      elastic->set_growth(mesh.region(region, 3).id, stretch);
+    } catch (const std::invalid_argument& e) {
+      throw InputError(scene_key(scene, "", "actuation.growth"), e.what());
+    }
+  }
   assembler.add_term(elastic);
   if (scene.gravity.norm() > 0) {
     // Gravity is a body force rho g [N/m^3]; rho depends on the cell's region, so
@@ -190,6 +207,11 @@ SimulationResult run_scene(const Scene& scene, MPI_Comm comm, const RunOptions& 
         mesh, partition, rank, mesh.faces_of(t.surface),
         [traction, scale](const Eigen::Vector3d&, double time) { return Eigen::Vector3d(scale(time) * traction); }));
   }
+  std::vector<std::shared_ptr<PullSpringTerm>> pulls;  // test-machine pull springs, only if declared
+  for (const auto& spec : scene.pulls) {
+    pulls.push_back(std::make_shared<PullSpringTerm>(mesh, rank, spec));
+    assembler.add_term(pulls.back());
+  }
   // Dynamics: inertia (and viscous damping) only when the scene asks for them.
   std::shared_ptr<InertiaTerm> inertia;
   std::shared_ptr<DampingTerm> damping;
@@ -221,6 +243,17 @@ SimulationResult run_scene(const Scene& scene, MPI_Comm comm, const RunOptions& 
       friction = std::make_shared<FrictionTerm>(mesh, partition, rank, ground, scene.friction_spec);
       assembler.add_term(friction);
     }
+  }
+  // Self-contact only between the declared surface pairs.
+  std::shared_ptr<SelfContactTerm> self_contact;
+  if (scene.self_contact) {
+    SelfContactSpec spec = scene.self_contact_spec;
+    double mu_max = 0;
+    for (const auto& m : materials)
+      if (m) mu_max = std::max(mu_max, m->shear_modulus());
+    spec.young_modulus = 3.0 * mu_max;  // as for the ground: E ~ 3 mu
+    self_contact = std::make_shared<SelfContactTerm>(mesh, partition, rank, spec);
+    assembler.add_term(self_contact);
   }
   std::vector<DirichletCondition> bcs;
   const double t_end = scene.solver.t_end;
@@ -265,6 +298,13 @@ SimulationResult run_scene(const Scene& scene, MPI_Comm comm, const RunOptions& 
     cavity_columns.push_back(c->spec().wall.name + "_volume_m3");
     cavity_columns.push_back(c->spec().wall.name + "_amount_mol");
   }
+  std::vector<std::string> pull_columns{"time"};
+  for (const auto& p : pulls) {
+    pull_columns.push_back(p->spec().surface + "_force_N");
+    pull_columns.push_back(p->spec().surface + "_crosshead_m");
+    pull_columns.push_back(p->spec().surface + "_mean_position_m");
+  }
+  std::vector<double> pull_force(pulls.size(), 0.0);  // last recorded [N]
   std::vector<std::string> energy_columns{"time"};
   for (const auto& term : assembler.terms()) energy_columns.push_back(term->name() + "_J");
   if (inertia) energy_columns.push_back("kinetic_J");
@@ -272,8 +312,25 @@ SimulationResult run_scene(const Scene& scene, MPI_Comm comm, const RunOptions& 
   if (damping) energy_columns.push_back("damping_dissipated_J");
   double friction_dissipated = 0.0;
 
+  // Gait: mean node position (the voxel study's "mean vertex") along the heading.
+  const double body_length =
+      scene.gait.body_length > 0 ? scene.gait.body_length : mesh.X.col(1).maxCoeff() - mesh.X.col(1).minCoeff();
+  const Eigen::Vector3d mean_X = mesh.X.colwise().mean();
+  double heading_at_start = std::numeric_limits<double>::quiet_NaN();
   auto record = [&](double t, bool force_write, int step) {
     result.u = assembler.gather_all(solver.solution());
+    for (size_t i = 0; i < pulls.size(); ++i) pull_force[i] = pulls[i]->force(result.u, t);
+    if (scene.gait.enabled) {
+      const Eigen::Vector3d centroid = mean_X + Eigen::Vector3d(result.u.colwise().mean());
+      result.trajectory.push_back({t, centroid.x(), centroid.y(), centroid.z()});
+      const double along = centroid.dot(scene.gait.heading), eps = 1e-9 * std::max(1.0, t_end);
+      if (std::abs(t - scene.gait.start) <= eps) heading_at_start = along;
+      if (std::abs(t - scene.gait.end) <= eps && std::isfinite(heading_at_start)) {
+        result.gait_displacement_m = along - heading_at_start;
+        result.speed_bl_per_s = result.gait_displacement_m / body_length / scene.gait.nominal_s;
+        result.gait_complete = true;
+      }
+    }
     result.cavity_pressure.clear();
     result.cavity_volume.clear();
     for (const auto& c : cavities) {
@@ -322,6 +379,14 @@ SimulationResult run_scene(const Scene& scene, MPI_Comm comm, const RunOptions& 
         contact_fields.push_back(Field{"friction_status", 1, std::vector<double>(f.status.begin(), f.status.end())});
       }
     }
+    if (self_contact && write && output_now) {
+      auto c = self_contact->nodal_contact(assembler, solver.solution());
+      contact_fields.push_back(
+          Field{"self_contact_force_N", 3, std::vector<double>(c.force.data(), c.force.data() + c.force.size())});
+      for (double& g : c.gap)
+        if (!std::isfinite(g)) g = -1.0;  // -1: node in no candidate pair
+      contact_fields.push_back(Field{"self_contact_gap_m", 1, c.gap});
+    }
     if (writer && output_now) {
       Field disp{"displacement", 3, std::vector<double>(result.u.data(), result.u.data() + result.u.size())};
       std::vector<Field> nodal{disp};
@@ -338,6 +403,15 @@ SimulationResult run_scene(const Scene& scene, MPI_Comm comm, const RunOptions& 
         row.push_back(gas_cavities[i]->amount());
       }
       if (cavity_columns.size() > 1) writer->append_row("cavities", cavity_columns, row);
+      if (!pulls.empty()) {
+        std::vector<double> prow{t};
+        for (size_t i = 0; i < pulls.size(); ++i) {
+          prow.push_back(pull_force[i]);
+          prow.push_back(pulls[i]->crosshead(t));
+          prow.push_back(pulls[i]->mean_position(result.u));
+        }
+        writer->append_row("pulls", pull_columns, prow);
+      }
       std::vector<double> erow{t};
       erow.insert(erow.end(), energies.begin(), energies.end());
       writer->append_row("energy", energy_columns, erow);
@@ -387,6 +461,34 @@ SimulationResult run_scene(const Scene& scene, MPI_Comm comm, const RunOptions& 
         cavs.push_back(c);
       }
       summary.add("cavities", cavs);
+      if (!pulls.empty()) {
+        std::vector<Json> pull_summary;
+        for (size_t i = 0; i < pulls.size(); ++i) {
+          Json p;
+          p.add("surface", pulls[i]->spec().surface)
+              .add("stiffness_N_per_m", pulls[i]->spec().stiffness)
+              .add("force_N", pull_force[i])
+              .add("crosshead_m", pulls[i]->crosshead(solver.time()));
+          pull_summary.push_back(p);
+        }
+        summary.add("pulls", pull_summary);
+      }
+      if (scene.gait.enabled) {
+        summary.add("gait_complete", result.gait_complete)
+            .add("displacement_m", result.gait_displacement_m)
+            .add("speed_bl_per_s", result.speed_bl_per_s)
+            .add("gait_time_s", scene.gait.nominal_s)
+            .add("simulated_gait_s", scene.gait.end - scene.gait.start)
+            .add("gait_start_s", scene.gait.start)
+            .add("body_length_m", body_length);
+        std::string csv = "time_s,centroid_x_m,centroid_y_m,centroid_z_m\n";
+        char line[160];
+        for (const auto& p : result.trajectory) {
+          std::snprintf(line, sizeof line, "%.9g,%.9g,%.9g,%.9g\n", p[0], p[1], p[2], p[3]);
+          csv += line;
+        }
+        write_file_atomic(tmp_dir + "/trajectory.csv", csv);
+      }
       write_file_atomic(tmp_dir + "/summary.json", summary.str(true) + "\n");
       commit_output_dir(tmp_dir, scene.output_dir);
       result.output_dir = scene.output_dir;

@@ -1,6 +1,7 @@
 // Runs a scene: builds the mesh and only the energy terms the scene declares,
 // solves in adaptive load steps, writes XDMF/HDF5 results and summary.json.
 #pragma once
+#include <array>
 #include <functional>
 #include <memory>
 #include <string>
@@ -22,6 +23,11 @@ struct SimulationResult {
   std::vector<double> cavity_pressure, cavity_volume;  // final [Pa], [m^3]
   double min_J = 0;                                    // smallest det F over quadrature points at the end
   std::string output_dir;                              // where results went ("" if none)
+  // Gait (scenes with an actuation schedule): centroid path (t, x, y, z) every step,
+  // displacement along the heading over the gait [m] and speed [body lengths / s].
+  std::vector<std::array<double, 4>> trajectory;
+  bool gait_complete = false;
+  double gait_displacement_m = 0, speed_bl_per_s = 0;
 };
 
 struct RunOptions {

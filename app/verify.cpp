@@ -8,8 +8,10 @@
 
 #include "app/simulation.h"
 #include "app/verify_cases.h"
+#include "app/verify_contact.h"
 #include "app/verify_gas.h"
 #include "app/verify_hard.h"
+#include "app/verify_self_contact.h"
 #include "core/errors.h"
 #include "core/json.h"
 #include "fem/element.h"
@@ -491,6 +493,9 @@ const std::map<std::string, CaseEntry>& cases() {
       {"cantilever", {cantilever_case, false}},
       {"slope", {slope_case, false}},
       {"friction_switch", {friction_switch_case, false}},
+      {"tube_vacuum", {tube_vacuum_case, false}},  // case 11: self-contact (verify_self_contact.h)
+      {"rolling", {rolling_case, false}},
+      {"hertz", {hertz_case, false}},
       // The hard-case suite (morphfem verify --hard): near-incompressibility,
       // large compression and rotation, limit points.
       {"cook", {cook_case, true}},

@@ -104,25 +104,43 @@ Feature closest_feature(const Eigen::Matrix<double, 4, 3>& x) {
   return best;
 }
 
-// Squared distance to the closest feature, with derivatives.
-Dual squared_distance(const Eigen::Matrix<double, 4, 3>& x, const Feature& f) {
+// Squared distances between features, with derivatives.
+Dual point_point_d2(const DualVec& p, const DualVec& q) {  // |p - q|^2
+  const DualVec r = sub(p, q);
+  return dot(r, r);
+}
+Dual point_line_d2(const DualVec& p, const DualVec& a, const DualVec& b) {  // |(p - a) x (b - a)|^2 / |b - a|^2
+  const DualVec e = sub(b, a);
+  const DualVec c = cross(sub(p, a), e);
+  return dot(c, c) * inverse(dot(e, e));
+}
+// ((p - a) . n)^2 / |n|^2, n = (b - a) x (c - a)
+Dual point_plane_d2(const DualVec& p, const DualVec& a, const DualVec& b, const DualVec& c) {
+  const DualVec n = cross(sub(b, a), sub(c, a));
+  const Dual h = dot(sub(p, a), n);
+  return h * h * inverse(dot(n, n));
+}
+
+// ((b0 - a0) . n)^2 / |n|^2, n = (a1 - a0) x (b1 - b0): the distance of two lines
+Dual line_line_d2(const DualVec& a0, const DualVec& a1, const DualVec& b0, const DualVec& b1) {
+  const DualVec n = cross(sub(a1, a0), sub(b1, b0));
+  const Dual h = dot(sub(b0, a0), n);
+  return h * h * inverse(dot(n, n));
+}
+
+std::array<DualVec, 4> dual_positions(const Eigen::Matrix<double, 4, 3>& x) {
   std::array<DualVec, 4> v;
   for (int a = 0; a < 4; ++a)
     for (int i = 0; i < 3; ++i) v[a][i] = variable(x(a, i), 3 * a + i);
-  const DualVec& p = v[0];
-  if (f.type == 1) {  // |p - x_i|^2
-    const DualVec r = sub(p, v[f.i]);
-    return dot(r, r);
-  }
-  if (f.type == 2) {  // |(p - x_i) x (x_j - x_i)|^2 / |x_j - x_i|^2
-    const DualVec e = sub(v[f.j], v[f.i]);
-    const DualVec c = cross(sub(p, v[f.i]), e);
-    return dot(c, c) * inverse(dot(e, e));
-  }
-  // ((p - a) . n)^2 / |n|^2, n = (b - a) x (c - a)
-  const DualVec n = cross(sub(v[2], v[1]), sub(v[3], v[1]));
-  const Dual h = dot(sub(p, v[1]), n);
-  return h * h * inverse(dot(n, n));
+  return v;
+}
+
+// Squared distance to the closest feature, with derivatives.
+Dual squared_distance(const Eigen::Matrix<double, 4, 3>& x, const Feature& f) {
+  const std::array<DualVec, 4> v = dual_positions(x);
+  if (f.type == 1) return point_point_d2(v[0], v[f.i]);
+  if (f.type == 2) return point_line_d2(v[0], v[f.i], v[f.j]);
+  return point_plane_d2(v[0], v[1], v[2], v[3]);
 }
 
 double plain_distance(const Eigen::Matrix<double, 4, 3>& x) {
@@ -135,6 +153,64 @@ double plain_distance(const Eigen::Matrix<double, 4, 3>& x) {
   }
   const Eigen::Vector3d a = x.row(1), n = (x.row(2).transpose() - a).cross(x.row(3).transpose() - a);
   return std::abs((p - a).dot(n)) / n.norm();
+}
+
+// Closest features of segments (x0, x1) and (x2, x3): line-line (type 3, the
+// closest points interior to both), point-line (type 2: point p, line i-j) or
+// point-point (type 1: p, i); rows 0..3 of x.
+struct EdgeFeature {
+  int type = 3;
+  int p = 0, i = 2, j = 3;
+};
+
+EdgeFeature closest_edge_feature(const Eigen::Matrix<double, 4, 3>& x) {
+  const Eigen::Vector3d u = x.row(1) - x.row(0), v = x.row(3) - x.row(2), w = x.row(0) - x.row(2);
+  const double a = u.dot(u), b = u.dot(v), c = v.dot(v), d = u.dot(w), e = v.dot(w);
+  const double D = a * c - b * b;  // |u x v|^2
+  if (D > 1e-12 * a * c) {
+    // Unconstrained minimiser of |x0 + s u - x2 - t v|^2; inside the unit square it is the minimum.
+    const double s = (b * e - c * d) / D, t = (a * e - b * d) / D;
+    if (s > 0 && s < 1 && t > 0 && t < 1) return EdgeFeature{3, 0, 2, 3};
+  }
+  // Otherwise on the square's boundary: the nearest of the four end-point-to-segment distances.
+  EdgeFeature best{1, 0, 2, 2};
+  double best_d2 = std::numeric_limits<double>::infinity();
+  const int cases[4][3] = {{0, 2, 3}, {1, 2, 3}, {2, 0, 1}, {3, 0, 1}};
+  for (const auto& cs : cases) {
+    const Eigen::Vector3d p = x.row(cs[0]), xi = x.row(cs[1]), xj = x.row(cs[2]);
+    const double len2 = (xj - xi).squaredNorm();
+    const double t = len2 > 0 ? std::clamp((p - xi).dot(xj - xi) / len2, 0.0, 1.0) : 0.0;
+    const double d2 = (p - (xi + t * (xj - xi))).squaredNorm();
+    if (d2 < best_d2) {
+      best_d2 = d2;
+      if (t <= 0)
+        best = EdgeFeature{1, cs[0], cs[1], cs[1]};
+      else if (t >= 1)
+        best = EdgeFeature{1, cs[0], cs[2], cs[2]};
+      else
+        best = EdgeFeature{2, cs[0], cs[1], cs[2]};
+    }
+  }
+  return best;
+}
+
+double plain_edge_distance(const Eigen::Matrix<double, 4, 3>& x) {
+  const EdgeFeature f = closest_edge_feature(x);
+  const Eigen::Vector3d p = x.row(f.p);
+  if (f.type == 1) return (p - x.row(f.i).transpose()).norm();
+  if (f.type == 2) {
+    const Eigen::Vector3d xi = x.row(f.i), e = x.row(f.j).transpose() - xi;
+    return (p - xi).cross(e).norm() / e.norm();
+  }
+  const Eigen::Vector3d u = x.row(1) - x.row(0), v = x.row(3) - x.row(2), n = u.cross(v);
+  return std::abs((x.row(2) - x.row(0)).dot(n.transpose())) / n.norm();
+}
+
+Dual squared_edge_distance(const Eigen::Matrix<double, 4, 3>& x, const EdgeFeature& f) {
+  const std::array<DualVec, 4> v = dual_positions(x);
+  if (f.type == 1) return point_point_d2(v[f.p], v[f.i]);
+  if (f.type == 2) return point_line_d2(v[f.p], v[f.i], v[f.j]);
+  return line_line_d2(v[0], v[1], v[2], v[3]);
 }
 
 // The triangles of a surface: P1 faces, or each P2 face split at its mid-nodes
@@ -182,6 +258,79 @@ double point_triangle_barrier(const Eigen::Matrix<double, 4, 3>& x, double area,
   return e.v;
 }
 
+double edge_edge_distance(const Eigen::Matrix<double, 4, 3>& x) { return plain_edge_distance(x); }
+
+double edge_edge_mollifier_threshold(const Eigen::Matrix<double, 4, 3>& x_reference) {
+  return 1e-3 * (x_reference.row(1) - x_reference.row(0)).squaredNorm() *
+         (x_reference.row(3) - x_reference.row(2)).squaredNorm();
+}
+
+// E = A m(c) kappa dhat phi(d/dhat), c = |e_a x e_b|^2, m(c) = (2 - c/eps) c/eps
+// below eps (1 above): product rule on the exact Dual derivatives of c and d.
+double edge_edge_barrier(const Eigen::Matrix<double, 4, 3>& x, double area, double kappa, double dhat, double eps,
+                         Eigen::VectorXd* g, Eigen::MatrixXd* H) {
+  if (g) g->setZero(12);
+  if (H) H->setZero(12, 12);
+  const double d_plain = plain_edge_distance(x);
+  if (!(d_plain > 0)) return std::numeric_limits<double>::infinity();
+  if (d_plain >= dhat) return 0.0;
+  const Dual d2 = squared_edge_distance(x, closest_edge_feature(x));
+  if (!(d2.v > 0)) return std::numeric_limits<double>::infinity();
+  const double d = std::sqrt(d2.v);
+  const Dual dist = chain(d2, d, 0.5 / d, -0.25 / (d * d * d));
+  double phi, dphi, d2phi;
+  log_barrier(d / dhat, phi, &dphi, &d2phi);
+  const double scale = area * kappa;
+  const Dual barrier = chain(dist, scale * dhat * phi, scale * dphi, scale * d2phi / dhat);
+  const std::array<DualVec, 4> v = dual_positions(x);
+  const DualVec n = cross(sub(v[1], v[0]), sub(v[3], v[2]));
+  const Dual c = dot(n, n);
+  Dual e = barrier;
+  if (c.v < eps) {  // m(c) = 2 c/eps - c^2/eps^2, m' = 2/eps - 2 c/eps^2, m'' = -2/eps^2
+    const Dual m = chain(c, (2.0 - c.v / eps) * c.v / eps, 2.0 / eps - 2.0 * c.v / (eps * eps), -2.0 / (eps * eps));
+    e = m * barrier;
+  }
+  if (g) *g = e.g;
+  if (H) *H = e.H;
+  return e.v;
+}
+
+namespace {
+
+// The unique edges of a side's triangles with their parent faces and area weights
+// A_e = sum over the triangles next to e of area/3 (reference configuration).
+void collect_edges(const RowMatrixXd& X, const std::vector<std::array<int, 3>>& triangles,
+                   const std::vector<int>& triangle_face, std::vector<std::array<int, 2>>& edges,
+                   std::vector<std::vector<int>>& edge_faces, std::vector<double>& edge_weight) {
+  std::map<std::array<int, 2>, int> index;
+  for (size_t t = 0; t < triangles.size(); ++t) {
+    const auto& tri = triangles[t];
+    const Eigen::Vector3d a = X.row(tri[0]), b = X.row(tri[1]), c = X.row(tri[2]);
+    const double area = 0.5 * (b - a).cross(c - a).norm();
+    for (int i = 0; i < 3; ++i) {
+      const std::array<int, 2> e{std::min(tri[i], tri[(i + 1) % 3]), std::max(tri[i], tri[(i + 1) % 3])};
+      auto [it, inserted] = index.emplace(e, static_cast<int>(edges.size()));
+      if (inserted) {
+        edges.push_back(e);
+        edge_faces.emplace_back();
+        edge_weight.push_back(0.0);
+      }
+      auto& faces = edge_faces[it->second];
+      if (std::find(faces.begin(), faces.end(), triangle_face[t]) == faces.end()) faces.push_back(triangle_face[t]);
+      edge_weight[it->second] += area / 3.0;
+    }
+  }
+}
+
+// Integer cell of a uniform grid with spacing `size` [m].
+using Cell = std::tuple<long, long, long>;
+Cell grid_cell(const Eigen::Vector3d& y, double size) {
+  return {static_cast<long>(std::floor(y[0] / size)), static_cast<long>(std::floor(y[1] / size)),
+          static_cast<long>(std::floor(y[2] / size))};
+}
+
+}  // namespace
+
 SelfContactTerm::SelfContactTerm(const Mesh& mesh, const Partition& partition, int rank, SelfContactSpec spec)
     : mesh_(mesh), spec_(std::move(spec)) {
   const std::string where = "self_contact." + spec_.name;
@@ -205,6 +354,7 @@ SelfContactTerm::SelfContactTerm(const Mesh& mesh, const Partition& partition, i
       all_faces.insert(all_faces.end(), faces.begin(), faces.end());
       side->points = mesh.nodes_of_surface(name);
       surface_triangles(mesh, faces, side->triangles, side->triangle_face);
+      collect_edges(mesh.X, side->triangles, side->triangle_face, side->edges, side->edge_faces, side->edge_weight);
       surface_nodes.insert(side->points.begin(), side->points.end());
     }
     sides_.push_back(std::move(sides));
@@ -212,51 +362,65 @@ SelfContactTerm::SelfContactTerm(const Mesh& mesh, const Partition& partition, i
   std::sort(all_faces.begin(), all_faces.end());
   all_faces.erase(std::unique(all_faces.begin(), all_faces.end()), all_faces.end());
   weight_ = nodal_area_weights(mesh, all_faces);
-  for (int a : surface_nodes)
+  surface_nodes_.assign(surface_nodes.begin(), surface_nodes.end());
+  for (int a : surface_nodes_)
     if (a >= rank_begin_ && a < rank_end_) trust_nodes_.push_back(a);
   anchor_.assign(mesh.n_nodes(), Eigen::Vector3d::Zero());
   build_candidates(mesh.X);
-  for (const Pair& pr : pairs_) {
-    Eigen::Matrix<double, 4, 3> x;
-    x.row(0) = mesh.X.row(pr.point);
-    for (int i = 0; i < 3; ++i) x.row(i + 1) = mesh.X.row(pr.triangle[i]);
-    if (!(plain_distance(x) > 0))
+  const RowMatrixXd zero = RowMatrixXd::Zero(mesh.n_nodes(), 3);
+  for (const Pair& pr : pairs_)
+    if (!(plain_distance(positions({pr.point, pr.triangle[0], pr.triangle[1], pr.triangle[2]}, zero)) > 0))
       throw InputError(where, "surfaces touch at the start (node " + std::to_string(pr.point) + ")");
-  }
+  for (const EdgePair& ep : edge_pairs_)
+    if (!(plain_edge_distance(positions(ep.nodes, zero)) > 0))
+      throw InputError(where, "surfaces touch at the start (edges " + std::to_string(ep.nodes[0]) + "-" +
+                                  std::to_string(ep.nodes[1]) + " and " + std::to_string(ep.nodes[2]) + "-" +
+                                  std::to_string(ep.nodes[3]) + ")");
 }
 
-// Uniform grid of triangle boxes inflated by dhat + r; a (point, triangle) pair is
-// a candidate if the point is a node of neither the triangle's face and their
-// distance is below dhat + r. Only points this rank owns.
+Eigen::Matrix<double, 4, 3> SelfContactTerm::positions(const std::array<int, 4>& nodes, const RowMatrixXd& u) const {
+  Eigen::Matrix<double, 4, 3> x;
+  for (int a = 0; a < 4; ++a) x.row(a) = mesh_.X.row(nodes[a]) + u.row(nodes[a]);
+  return x;
+}
+
+// Uniform grids of bounding boxes inflated by reach = dhat + r. A (point,
+// triangle) pair is a candidate if the point is not a node of the triangle's face
+// and their distance is below reach (only points this rank owns); an edge pair if
+// the edges share no node and no parent face and their distance is below reach
+// (only pairs whose smallest node this rank owns).
 void SelfContactTerm::build_candidates(const RowMatrixXd& x) {
   pairs_.clear();
+  edge_pairs_.clear();
   const double reach = spec_.dhat + spec_.inflation;
+  const auto box = [&](const auto& nodes, Eigen::Vector3d& lo, Eigen::Vector3d& hi) {
+    lo = x.row(nodes[0]);
+    hi = lo;
+    for (size_t i = 1; i < nodes.size(); ++i) {
+      lo = lo.cwiseMin(x.row(nodes[i]).transpose());
+      hi = hi.cwiseMax(x.row(nodes[i]).transpose());
+    }
+  };
   std::set<std::tuple<int, int, int, int>> seen;
-  for (const auto& [side_a, side_b] : sides_)
+  std::set<std::array<int, 4>> seen_edges;
+  for (const auto& [side_a, side_b] : sides_) {
     for (const auto& [points, tris] : {std::pair{&side_a, &side_b}, std::pair{&side_b, &side_a}}) {
       double size = reach;
       for (const auto& t : tris->triangles)
         for (int i = 0; i < 3; ++i) size = std::max(size, (x.row(t[i]) - x.row(t[(i + 1) % 3])).cwiseAbs().maxCoeff());
-      const auto cell = [&](const Eigen::Vector3d& y) {
-        return std::make_tuple(static_cast<long>(std::floor(y[0] / size)), static_cast<long>(std::floor(y[1] / size)),
-                               static_cast<long>(std::floor(y[2] / size)));
-      };
-      std::map<std::tuple<long, long, long>, std::vector<int>> grid;
+      std::map<Cell, std::vector<int>> grid;
       for (size_t t = 0; t < tris->triangles.size(); ++t) {
-        Eigen::Vector3d lo = x.row(tris->triangles[t][0]), hi = lo;
-        for (int i = 1; i < 3; ++i) {
-          lo = lo.cwiseMin(x.row(tris->triangles[t][i]).transpose());
-          hi = hi.cwiseMax(x.row(tris->triangles[t][i]).transpose());
-        }
-        const auto [x0, y0, z0] = cell((lo.array() - reach).matrix());
-        const auto [x1, y1, z1] = cell((hi.array() + reach).matrix());
+        Eigen::Vector3d lo, hi;
+        box(tris->triangles[t], lo, hi);
+        const auto [x0, y0, z0] = grid_cell((lo.array() - reach).matrix(), size);
+        const auto [x1, y1, z1] = grid_cell((hi.array() + reach).matrix(), size);
         for (long i = x0; i <= x1; ++i)
           for (long j = y0; j <= y1; ++j)
             for (long k = z0; k <= z1; ++k) grid[{i, j, k}].push_back(static_cast<int>(t));
       }
       for (int p : points->points) {
         if (p < rank_begin_ || p >= rank_end_) continue;
-        const auto it = grid.find(cell(x.row(p).transpose()));
+        const auto it = grid.find(grid_cell(x.row(p).transpose(), size));
         if (it == grid.end()) continue;
         for (int t : it->second) {
           const auto& tri = tris->triangles[t];
@@ -272,29 +436,91 @@ void SelfContactTerm::build_candidates(const RowMatrixXd& x) {
         }
       }
     }
+    if (!spec_.edge_edge) continue;
+    // Edge pairs: edges of B in every cell their inflated box touches; each edge of
+    // A looks in the cells of its own box (cells at least as large as any edge).
+    double size = reach;
+    for (const auto& e : side_b.edges) size = std::max(size, (x.row(e[0]) - x.row(e[1])).cwiseAbs().maxCoeff());
+    for (const auto& e : side_a.edges) size = std::max(size, (x.row(e[0]) - x.row(e[1])).cwiseAbs().maxCoeff());
+    std::map<Cell, std::vector<int>> grid;
+    for (size_t k = 0; k < side_b.edges.size(); ++k) {
+      Eigen::Vector3d lo, hi;
+      box(side_b.edges[k], lo, hi);
+      const auto [x0, y0, z0] = grid_cell((lo.array() - reach).matrix(), size);
+      const auto [x1, y1, z1] = grid_cell((hi.array() + reach).matrix(), size);
+      for (long i = x0; i <= x1; ++i)
+        for (long j = y0; j <= y1; ++j)
+          for (long l = z0; l <= z1; ++l) grid[{i, j, l}].push_back(static_cast<int>(k));
+    }
+    std::set<int> near;
+    for (size_t ka = 0; ka < side_a.edges.size(); ++ka) {
+      const auto& ea = side_a.edges[ka];
+      Eigen::Vector3d lo, hi;
+      box(ea, lo, hi);
+      const auto [x0, y0, z0] = grid_cell(lo, size);
+      const auto [x1, y1, z1] = grid_cell(hi, size);
+      near.clear();
+      for (long i = x0; i <= x1; ++i)
+        for (long j = y0; j <= y1; ++j)
+          for (long l = z0; l <= z1; ++l) {
+            const auto it = grid.find({i, j, l});
+            if (it != grid.end()) near.insert(it->second.begin(), it->second.end());
+          }
+      for (int kb : near) {
+        const auto& eb = side_b.edges[kb];
+        if (ea[0] == eb[0] || ea[0] == eb[1] || ea[1] == eb[0] || ea[1] == eb[1]) continue;
+        const int smallest = std::min(std::min(ea[0], ea[1]), std::min(eb[0], eb[1]));
+        if (smallest < rank_begin_ || smallest >= rank_end_) continue;
+        bool shared_face = false;
+        for (int f : side_a.edge_faces[ka])
+          for (int g : side_b.edge_faces[kb]) shared_face = shared_face || f == g;
+        if (shared_face) continue;
+        // One orientation per unordered pair (the same surface on both sides).
+        const std::array<int, 4> key =
+            ea < eb ? std::array<int, 4>{ea[0], ea[1], eb[0], eb[1]} : std::array<int, 4>{eb[0], eb[1], ea[0], ea[1]};
+        Eigen::Matrix<double, 4, 3> xs;
+        for (int i = 0; i < 4; ++i) xs.row(i) = x.row(key[i]);
+        if (plain_edge_distance(xs) >= reach) continue;
+        if (!seen_edges.insert(key).second) continue;
+        Eigen::Matrix<double, 4, 3> xref;
+        for (int i = 0; i < 4; ++i) xref.row(i) = mesh_.X.row(key[i]);
+        edge_pairs_.push_back(EdgePair{key, 0.5 * (side_a.edge_weight[ka] + side_b.edge_weight[kb]),
+                                       edge_edge_mollifier_threshold(xref)});
+      }
+    }
+  }
 }
 
 void SelfContactTerm::piece_nodes(int k, std::vector<int>& nodes) const {
-  const int n_pairs = static_cast<int>(pairs_.size());
+  const int n_pairs = static_cast<int>(pairs_.size()), n_edge = static_cast<int>(edge_pairs_.size());
   if (k < n_pairs) {
     const Pair& p = pairs_[k];
     nodes = {p.point, p.triangle[0], p.triangle[1], p.triangle[2]};
+  } else if (k < n_pairs + n_edge) {
+    const auto& e = edge_pairs_[k - n_pairs].nodes;
+    nodes.assign(e.begin(), e.end());
   } else {
-    nodes.assign(1, trust_nodes_[k - n_pairs]);
+    nodes.assign(1, trust_nodes_[k - n_pairs - n_edge]);
   }
 }
 
 double SelfContactTerm::piece(int k, const PieceState& s, Eigen::VectorXd* g, Eigen::MatrixXd* H) const {
-  const int n_pairs = static_cast<int>(pairs_.size());
-  if (k >= n_pairs) {  // trust region: |u - u_c| <= r/2
+  const int n_pairs = static_cast<int>(pairs_.size()), n_edge = static_cast<int>(edge_pairs_.size());
+  if (k >= n_pairs + n_edge) {  // trust region: |u - u_c| <= r/2
     if (g) g->setZero(3);
     if (H) H->setZero(3, 3);
-    const int node = trust_nodes_[k - n_pairs];
+    const int node = trust_nodes_[k - n_pairs - n_edge];
     const double moved = (s.u.row(0).transpose() - anchor_[node]).norm();
     return moved <= 0.5 * spec_.inflation ? 0.0 : std::numeric_limits<double>::infinity();
   }
-  Eigen::Matrix<double, 4, 3> x = s.X + s.u;
-  const double e = point_triangle_barrier(x, weight_[pairs_[k].point], spec_.kappa, spec_.dhat, g, H);
+  const Eigen::Matrix<double, 4, 3> x = s.X + s.u;
+  double e;
+  if (k < n_pairs) {
+    e = point_triangle_barrier(x, weight_[pairs_[k].point], spec_.kappa, spec_.dhat, g, H);
+  } else {
+    const EdgePair& ep = edge_pairs_[k - n_pairs];
+    e = edge_edge_barrier(x, ep.weight, spec_.kappa, spec_.dhat, ep.eps, g, H);
+  }
   if (H && spec_.project_hessian && std::isfinite(e) && e > 0) {
     Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(*H);
     const Eigen::VectorXd lambda = es.eigenvalues().cwiseMax(0.0);
@@ -308,15 +534,27 @@ double SelfContactTerm::max_step(Assembler& assembler, Vec u, Vec du) {
   const std::vector<double>& du_local = assembler.gather(du);
   const auto U = [&](int n) { return Eigen::Vector3d::Map(&u_local[3 * assembler.node_slot(n)]); };
   const auto dU = [&](int n) { return Eigen::Vector3d::Map(&du_local[3 * assembler.node_slot(n)]); };
+  const auto current = [&](const std::array<int, 4>& nodes) {
+    Eigen::Matrix<double, 4, 3> x;
+    for (int a = 0; a < 4; ++a) x.row(a) = mesh_.X.row(nodes[a]) + U(nodes[a]).transpose();
+    return x;
+  };
   double alpha = 1.0;
   for (const Pair& pr : pairs_) {
     double L = 0.0;
     for (int i = 0; i < 3; ++i) L = std::max(L, (dU(pr.triangle[i]) - dU(pr.point)).norm());
     if (L <= 0) continue;
-    Eigen::Matrix<double, 4, 3> x;
-    x.row(0) = mesh_.X.row(pr.point) + U(pr.point).transpose();
-    for (int i = 0; i < 3; ++i) x.row(i + 1) = mesh_.X.row(pr.triangle[i]) + U(pr.triangle[i]).transpose();
-    alpha = std::min(alpha, spec_.max_step_fraction * plain_distance(x) / L);
+    const double d = plain_distance(current({pr.point, pr.triangle[0], pr.triangle[1], pr.triangle[2]}));
+    alpha = std::min(alpha, spec_.max_step_fraction * d / L);
+  }
+  for (const EdgePair& ep : edge_pairs_) {
+    const auto& n = ep.nodes;
+    const Eigen::Vector3d origin = dU(n[0]);
+    const double La = (dU(n[1]) - origin).norm();
+    const double Lb = std::max((dU(n[2]) - origin).norm(), (dU(n[3]) - origin).norm());
+    const double L = La + Lb;
+    if (L <= 0) continue;
+    alpha = std::min(alpha, spec_.max_step_fraction * plain_edge_distance(current(n)) / L);
   }
   // Trust region: largest alpha with |a + alpha b| <= R, a = u - u_c, b = du.
   const double R = 0.5 * spec_.inflation;
@@ -333,25 +571,68 @@ double SelfContactTerm::max_step(Assembler& assembler, Vec u, Vec du) {
   return global;
 }
 
-void SelfContactTerm::refresh(Assembler& assembler, Vec u) {
-  const RowMatrixXd U = assembler.gather_all(u);
-  for (int a = 0; a < mesh_.n_nodes(); ++a) anchor_[a] = U.row(a).transpose();
-  build_candidates(mesh_.X + U);
+bool SelfContactTerm::refresh_pieces(Assembler& assembler, Vec u0) {
+  const RowMatrixXd U = assembler.gather_all(u0);  // the same field on every rank: the same decision
+  double moved = 0.0;
+  for (int a : surface_nodes_) moved = std::max(moved, (U.row(a).transpose() - anchor_[a]).norm());
+  if (moved <= 0.25 * spec_.inflation) return false;
+  refresh(U);
+  return true;
+}
+
+void SelfContactTerm::refresh(Assembler& assembler, Vec u) { refresh(assembler.gather_all(u)); }
+
+void SelfContactTerm::refresh(const RowMatrixXd& u) {
+  for (int a = 0; a < mesh_.n_nodes(); ++a) anchor_[a] = u.row(a).transpose();
+  build_candidates(mesh_.X + u);
+  ++n_refreshes_;
 }
 
 double SelfContactTerm::min_distance(Assembler& assembler, Vec u) const {
-  const std::vector<double>& u_local = assembler.gather(u);
+  const RowMatrixXd U = assembler.gather_all(u);
   double local = std::numeric_limits<double>::infinity();
-  for (const Pair& pr : pairs_) {
-    Eigen::Matrix<double, 4, 3> x;
-    const std::array<int, 4> nodes{pr.point, pr.triangle[0], pr.triangle[1], pr.triangle[2]};
-    for (int a = 0; a < 4; ++a)
-      x.row(a) = mesh_.X.row(nodes[a]) + Eigen::RowVector3d::Map(&u_local[3 * assembler.node_slot(nodes[a])]);
-    local = std::min(local, plain_distance(x));
-  }
+  for (const Pair& pr : pairs_)
+    local = std::min(local, plain_distance(positions({pr.point, pr.triangle[0], pr.triangle[1], pr.triangle[2]}, U)));
+  for (const EdgePair& ep : edge_pairs_) local = std::min(local, plain_edge_distance(positions(ep.nodes, U)));
   double global = local;
   MPI_Allreduce(&local, &global, 1, MPI_DOUBLE, MPI_MIN, assembler.comm());
   return global;
+}
+
+SelfContactNodal SelfContactTerm::nodal_contact(const RowMatrixXd& u) const {
+  SelfContactNodal out;
+  out.force = RowMatrixXd::Zero(mesh_.n_nodes(), 3);
+  out.gap.assign(mesh_.n_nodes(), std::numeric_limits<double>::infinity());
+  Eigen::VectorXd g;
+  const auto add = [&](const std::array<int, 4>& nodes, double d, double e) {
+    for (int a = 0; a < 4; ++a) {
+      out.gap[nodes[a]] = std::min(out.gap[nodes[a]], d);
+      if (std::isfinite(e)) out.force.row(nodes[a]) -= g.segment<3>(3 * a).transpose();
+    }
+  };
+  for (const Pair& pr : pairs_) {
+    const std::array<int, 4> nodes{pr.point, pr.triangle[0], pr.triangle[1], pr.triangle[2]};
+    const Eigen::Matrix<double, 4, 3> x = positions(nodes, u);
+    const double e = point_triangle_barrier(x, weight_[pr.point], spec_.kappa, spec_.dhat, &g, nullptr);
+    add(nodes, plain_distance(x), e);
+  }
+  for (const EdgePair& ep : edge_pairs_) {
+    const Eigen::Matrix<double, 4, 3> x = positions(ep.nodes, u);
+    const double e = edge_edge_barrier(x, ep.weight, spec_.kappa, spec_.dhat, ep.eps, &g, nullptr);
+    add(ep.nodes, plain_edge_distance(x), e);
+  }
+  return out;
+}
+
+SelfContactNodal SelfContactTerm::nodal_contact(Assembler& assembler, Vec u) const {
+  SelfContactNodal local = nodal_contact(assembler.gather_all(u)), out;
+  out.force = RowMatrixXd::Zero(mesh_.n_nodes(), 3);
+  out.gap.assign(mesh_.n_nodes(), 0.0);
+  MPI_Allreduce(local.force.data(), out.force.data(), static_cast<int>(local.force.size()), MPI_DOUBLE, MPI_SUM,
+                assembler.comm());
+  MPI_Allreduce(local.gap.data(), out.gap.data(), static_cast<int>(local.gap.size()), MPI_DOUBLE, MPI_MIN,
+                assembler.comm());
+  return out;
 }
 
 }  // namespace morphfem

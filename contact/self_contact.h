@@ -1,8 +1,9 @@
 // Self-contact between declared surface regions (or within one), e.g. the inner
 // faces of a collapsing cavity: the same log barrier as the ground (barrier.h) on
-// point-triangle distances,
+// point-triangle and edge-edge distances (as in IPC),
 //
 //   E = sum_(p, T) A_p kappa dhat phi(d(p, T) / dhat)                    [J]
+//     + sum_(e, e') A_ee' m(|e x e'|^2) kappa dhat phi(d(e, e') / dhat)
 //
 // p a surface node (P2: vertices and mid-nodes), T a triangle of the other
 // surface (P2 faces split at their mid-nodes into four flat sub-triangles, so the
@@ -12,22 +13,38 @@
 // exactly within that feature), A_p the nodal area weight [m^2] (as the ground's).
 // A point whose nearest feature is an edge or vertex shared by k triangles counts
 // k times there (a stiffer barrier near edges; admissibility is unaffected).
-// Pairs whose point is a node of the triangle's own face are skipped. Edge-edge
-// distances are NOT included: two edges can cross without a vertex touching a
-// face (only likely with coarse meshes of sharp folds).
+// Pairs whose point is a node of the triangle's own face are skipped.
+//
+// Edge-edge: e, e' edges of the two surfaces' (sub-)triangles, d their segment
+// distance (closest features: line-line, point-line or point-point), weight
+// A_ee' = (A_e + A_e')/2 with A_e a third of the reference area of the
+// (sub-)triangles next to the edge [m^2]. Without them two edges could cross
+// without a vertex reaching a face (coarse meshes of sharp folds). Near-parallel
+// edges: the line-line distance is ill-conditioned there, so the energy is
+// multiplied by IPC's mollifier
+//   m(x) = (2 - x/eps) x/eps for x < eps, 1 otherwise,  x = |e x e'|^2 [m^4],
+//   eps = 1e-3 |E|^2 |E'|^2 (reference edges):
+// m is C1 and vanishes for parallel edges, whose contact the point-triangle pairs
+// carry (an end point then meets a face or an edge). Edge pairs sharing a node or
+// a parent face are skipped. A state with any candidate distance d <= 0 has +inf
+// energy (edge-edge too, whatever m).
 //
 // Candidates (broad phase): pairs with d < dhat + r at the configuration u_c of
-// construction (or of refresh()), r = inflation [m], found with a uniform grid of
-// triangle bounding boxes. Pieces are fixed between refreshes, so the term keeps
-// every surface node within r/2 of u_c (energy +inf beyond, and max_step stops
-// there): then no pair outside the candidate set can come closer than dhat.
-// A run whose motion exceeds r/2 needs refresh() + Assembler::setup() between
-// steps (see the report: the solver needs a re-setup hook for that).
+// construction (or of the last refresh), r = inflation [m], found with uniform
+// grids of triangle and edge bounding boxes. Pieces are fixed between refreshes,
+// so the term keeps every surface node within r/2 of u_c (energy +inf beyond, and
+// max_step stops there): then no pair outside the candidate set can come closer
+// than dhat (every distance is 1-Lipschitz in each node's position, so two nodes
+// moving r/2 each change it by at most r). During a run refresh_pieces() (called
+// by the solver before each step with the converged state) rebuilds the candidates
+// once some surface node has used half of that trust radius (motion > r/4); the
+// solver then re-creates the assembly pattern.
 //
 // max_step (conservative CCD): along u + alpha du the distance of a pair changes
 // by at most alpha L, L = max_i |du_i - du_p| over the triangle's vertices i (the
 // distance is 1-Lipschitz in each position, and a common translation leaves it
-// unchanged), so alpha <= s d / L keeps d >= (1 - s) d > 0.
+// unchanged); for an edge pair L = max_(i in e) |du_i - du_o| + max_(j in e')
+// |du_j - du_o|, o the first node of e. So alpha <= s d / L keeps d >= (1 - s) d > 0.
 #pragma once
 #include <array>
 #include <string>
@@ -51,6 +68,7 @@ struct SelfContactSpec {
   double inflation = 0.0;      // candidate radius r beyond dhat [m]; <= 0: 20 dhat
   double max_step_fraction = 0.9;
   bool project_hessian = true;  // per-pair PSD projection of the barrier Hessian
+  bool edge_edge = true;        // include the edge-edge pairs
 };
 
 // Point-triangle barrier kernel: x is 4 x 3 (point, then triangle vertices a, b, c)
@@ -60,6 +78,24 @@ double point_triangle_distance(const Eigen::Matrix<double, 4, 3>& x);
 double point_triangle_barrier(const Eigen::Matrix<double, 4, 3>& x, double area, double kappa, double dhat,
                               Eigen::VectorXd* g, Eigen::MatrixXd* H);
 
+// Edge-edge kernels: x is 4 x 3 (edge a0-a1, then edge b0-b1) [m]. The segment
+// distance [m]; the mollifier threshold eps = 1e-3 |a1 - a0|^2 |b1 - b0|^2 [m^4]
+// of a (reference) configuration; the barrier A m(|e_a x e_b|^2) kappa dhat
+// phi(d/dhat) [J] (+inf if d <= 0, 0 if d >= dhat) with optional gradient (12)
+// and exact Hessian (12 x 12).
+double edge_edge_distance(const Eigen::Matrix<double, 4, 3>& x);
+double edge_edge_mollifier_threshold(const Eigen::Matrix<double, 4, 3>& x_reference);
+double edge_edge_barrier(const Eigen::Matrix<double, 4, 3>& x, double area, double kappa, double dhat, double eps,
+                         Eigen::VectorXd* g, Eigen::MatrixXd* H);
+
+// Per-node self-contact data (every mesh node; n_nodes rows): force on the node
+// from the barrier, -dE/dx [N], and the smallest candidate distance of a pair the
+// node belongs to [m] (+inf if none).
+struct SelfContactNodal {
+  RowMatrixXd force;
+  std::vector<double> gap;
+};
+
 class SelfContactTerm : public EnergyTerm {
  public:
   // Candidates from the reference configuration. Throws InputError for unknown
@@ -67,42 +103,67 @@ class SelfContactTerm : public EnergyTerm {
   SelfContactTerm(const Mesh& mesh, const Partition& partition, int rank, SelfContactSpec spec);
 
   std::string name() const override { return "self_contact:" + spec_.name; }
-  int n_pieces() const override { return static_cast<int>(pairs_.size() + trust_nodes_.size()); }
+  int n_pieces() const override { return static_cast<int>(pairs_.size() + edge_pairs_.size() + trust_nodes_.size()); }
   void piece_nodes(int k, std::vector<int>& nodes) const override;
   double piece(int k, const PieceState& s, Eigen::VectorXd* g, Eigen::MatrixXd* H) const override;
   double max_step(Assembler& assembler, Vec u, Vec du) override;
+  // Rebuilds the candidates at u0 once a surface node moved more than r/4 since
+  // the last refresh (returns true: the solver re-creates the pattern). Collective.
+  bool refresh_pieces(Assembler& assembler, Vec u0) override;
 
   // Rebuilds the candidate pairs at displacement u (collective) and moves the
   // trust anchor there. The pieces change: call assembler.setup() afterwards and
   // re-create matrices.
   void refresh(Assembler& assembler, Vec u);
+  // The same from the whole displacement field (n_nodes x 3, identical on every rank).
+  void refresh(const RowMatrixXd& u);
 
   const SelfContactSpec& spec() const { return spec_; }
   int n_pairs() const { return static_cast<int>(pairs_.size()); }
-  // Smallest point-triangle distance over the candidate pairs [m] (collective).
+  int n_edge_pairs() const { return static_cast<int>(edge_pairs_.size()); }
+  int n_refreshes() const { return n_refreshes_; }
+  // Smallest point-triangle / edge-edge distance over the candidate pairs [m] (collective).
   double min_distance(Assembler& assembler, Vec u) const;
+  // Nodal forces and gaps of this rank's pairs at the whole displacement field u
+  // (no communication; with one rank, or summed over ranks, the full field).
+  SelfContactNodal nodal_contact(const RowMatrixXd& u) const;
+  // The same for every node, reduced over the ranks (collective).
+  SelfContactNodal nodal_contact(Assembler& assembler, Vec u) const;
 
  private:
   struct Pair {
     int point;
     std::array<int, 3> triangle;
   };
+  struct EdgePair {
+    std::array<int, 4> nodes;  // a0 a1 b0 b1
+    double weight;             // A_ee' [m^2]
+    double eps;                // mollifier threshold [m^4]
+  };
   void build_candidates(const RowMatrixXd& x);  // x: current positions of every node
+  Eigen::Matrix<double, 4, 3> positions(const std::array<int, 4>& nodes, const RowMatrixXd& u) const;
 
   const Mesh& mesh_;
   int rank_begin_ = 0, rank_end_ = 0;
   SelfContactSpec spec_;
   std::vector<double> weight_;  // nodal area weight [m^2] per mesh node
-  // Per surface pair: points of side A against triangles of side B (and B vs A).
+  // Per surface pair: points of side A against triangles of side B (and B vs A),
+  // edges of A against edges of B.
   struct Side {
     std::vector<int> points;
     std::vector<std::array<int, 3>> triangles;
-    std::vector<int> triangle_face;  // parent face of each triangle
+    std::vector<int> triangle_face;            // parent face of each triangle
+    std::vector<std::array<int, 2>> edges;     // unique edges of the triangles (sorted node ids)
+    std::vector<std::vector<int>> edge_faces;  // parent faces of each edge
+    std::vector<double> edge_weight;           // A_e [m^2]
   };
   std::vector<std::pair<Side, Side>> sides_;
   std::vector<Pair> pairs_;              // owned pairs (owner of the point)
+  std::vector<EdgePair> edge_pairs_;     // owned edge pairs (owner of the smallest node)
   std::vector<int> trust_nodes_;         // owned surface nodes
+  std::vector<int> surface_nodes_;       // every surface node
   std::vector<Eigen::Vector3d> anchor_;  // per mesh node: displacement at the last refresh [m]
+  int n_refreshes_ = 0;
 };
 
 }  // namespace morphfem

@@ -19,6 +19,27 @@ ElasticTerm::ElasticTerm(const Mesh& mesh, const Partition& partition, int rank,
     }
   int degree = quadrature_degree > 0 ? quadrature_degree : (mesh.order == 1 ? 1 : 2);
   table_ = make_tet_table(mesh.order, degree);
+  growth_stretch_.assign(mesh.regions.size(), Eigen::Vector3d::Ones());
+}
+
+void ElasticTerm::set_growth(int region, GrowthFunction growth) {
+  if (region < 0 || region >= static_cast<int>(mesh_.regions.size()))
+    throw std::invalid_argument("growth: no region " + std::to_string(region));
+  growth_.resize(mesh_.regions.size());
+  growth_[region] = std::move(growth);
+  has_growth_ = true;
+  set_time(0.0);
+}
+
+void ElasticTerm::set_time(double t) {
+  if (!has_growth_) return;
+  for (size_t r = 0; r < growth_.size(); ++r) {
+    if (!growth_[r]) continue;
+    const Eigen::Vector3d g = growth_[r](t);
+    if (!(g.minCoeff() > 0))
+      throw std::invalid_argument("growth of region '" + mesh_.regions[r].name + "' must stay positive");
+    growth_stretch_[r] = g;
+  }
 }
 
 void ElasticTerm::piece_nodes(int k, std::vector<int>& nodes) const {
@@ -27,7 +48,14 @@ void ElasticTerm::piece_nodes(int k, std::vector<int>& nodes) const {
 }
 
 double ElasticTerm::piece(int k, const PieceState& s, Eigen::VectorXd* g, Eigen::MatrixXd* H) const {
-  const Material& material = *materials_[mesh_.cell_region[cells_[k]]];
+  const int region = mesh_.cell_region[cells_[k]];
+  const Material& material = *materials_[region];
+  // Growth: W_G(F) = det G W(F G^-1); h_J = 1/g_J scales column J of F (see the header).
+  const Eigen::Vector3d h = growth_stretch_[region].cwiseInverse();
+  const double det_G = growth_stretch_[region].prod();
+  const bool grown = det_G != 1.0 || h != Eigen::Vector3d::Ones();
+  Eigen::Matrix<double, 9, 1> column_scale;  // h_J at flat index 3*i + J
+  for (int i = 0; i < 3; ++i) column_scale.segment<3>(3 * i) = h;
   const int n = static_cast<int>(s.X.rows());
   if (g) g->setZero(3 * n);
   if (H) H->setZero(3 * n, 3 * n);
@@ -40,12 +68,18 @@ double ElasticTerm::piece(int k, const PieceState& s, Eigen::VectorXd* g, Eigen:
     // F_iJ = delta_iJ + sum_a u_ai dN_a/dX_J
     Mat3 F = Mat3::Identity() + s.u.transpose() * dN_dX;
     if (F.determinant() <= 0.0) return std::numeric_limits<double>::infinity();
+    if (grown) F = F * h.asDiagonal();  // F_e = F G^-1
     if (!g && !H) {
-      energy += dV * material.energy(F);
+      energy += dV * det_G * material.energy(F);
       continue;
     }
     double W;
     material.evaluate(F, W, P, H ? &A : nullptr);
+    if (grown) {
+      W *= det_G;
+      P = det_G * P * h.asDiagonal();
+      if (H) A = det_G * column_scale.asDiagonal() * A * column_scale.asDiagonal();
+    }
     energy += dV * W;
     deformation_gradient_map(dN_dX, B);
     if (g) {
@@ -69,8 +103,10 @@ ElasticTerm::CellMeasures ElasticTerm::measures(int k, const PieceState& s) cons
     Mat3 P;
     double vm = 0.0;
     if (J > 0) {
-      material.evaluate(F, W, P, nullptr);
-      Mat3 sigma = P * F.transpose() / J;  // Cauchy stress [Pa]
+      // Cauchy stress from the elastic part F_e = F G^-1: sigma = P(F_e) F_e^T / det F_e [Pa].
+      const Mat3 Fe = F * growth_stretch_[mesh_.cell_region[cells_[k]]].cwiseInverse().asDiagonal();
+      material.evaluate(Fe, W, P, nullptr);
+      Mat3 sigma = P * Fe.transpose() / Fe.determinant();
       Mat3 dev = sigma - sigma.trace() / 3.0 * Mat3::Identity();
       vm = std::sqrt(1.5 * dev.squaredNorm());
     }

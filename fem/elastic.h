@@ -1,6 +1,14 @@
 // Elastic strain energy  E = sum_cells int_cell W(F) dV  (reference volume),
 // F = I + grad_X u. One piece per cell owned by this rank; the material is chosen
 // by the cell's volume region.
+//
+// Prescribed growth (active strain), optional per volume region: F = F_e G with
+// G = diag(g_x, g_y, g_z)(t) along the reference axes (the voxel study's
+// per-axis "external scale factor" of a bladder block), stress-free when F = G.
+// The energy per reference volume is  W_G(F) = det G W(F G^-1), so
+//   P_G(F)_iJ        = det G P(F_e)_iJ / g_J                       [Pa]
+//   A_G(F)_iJkL      = det G A(F_e)_iJkL / (g_J g_L)
+// (no sum; G diagonal). Growth changes with time through set_time(t).
 #pragma once
 #include <functional>
 #include <map>
@@ -39,11 +47,20 @@ class ElasticTerm : public EnergyTerm {
   std::vector<CellMeasures> measures_all(const RowMatrixXd& u) const;
   int cell_of_piece(int k) const { return cells_[k]; }
 
+  // Growth stretches (g_x, g_y, g_z)(t) > 0 of one volume region (replaces an
+  // earlier one). Formulations that cannot grow refuse it (std::invalid_argument).
+  using GrowthFunction = std::function<Eigen::Vector3d(double t)>;
+  virtual void set_growth(int region, GrowthFunction growth);
+  void set_time(double t) override;
+
  protected:
   const Mesh& mesh_;
   std::vector<int> cells_;
   std::vector<std::shared_ptr<const Material>> materials_;
   ShapeTable table_;
+  std::vector<GrowthFunction> growth_;           // per region (empty: no growth)
+  std::vector<Eigen::Vector3d> growth_stretch_;  // per region, at the current time
+  bool has_growth_ = false;
 };
 
 // Element formulations of the elastic energy, registered by name in one table

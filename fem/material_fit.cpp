@@ -16,239 +16,86 @@
 
 #include "core/errors.h"
 #include "core/json.h"
+#include "core/test_machine_export.h"
 
 namespace morphfem {
 
 namespace {
 
-std::string trim(const std::string& s) {
-  size_t a = 0, b = s.size();
-  while (a < b && std::isspace(static_cast<unsigned char>(s[a]))) ++a;
-  while (b > a && std::isspace(static_cast<unsigned char>(s[b - 1]))) --b;
-  return s.substr(a, b - a);
-}
-
-std::string lower(std::string s) {
-  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return s;
-}
-
-std::vector<std::string> split_fields(const std::string& line) {
-  std::vector<std::string> out;
-  std::string field;
-  std::istringstream in(line);
-  while (std::getline(in, field, ';')) out.push_back(trim(field));
-  if (!line.empty() && line.back() == ';') out.push_back("");
-  return out;
-}
-
-// A number, accepting a decimal comma ("0,25") as European exports write it.
-std::optional<double> parse_number(std::string s) {
-  s = trim(s);
-  if (s.empty()) return std::nullopt;
-  if (s.find(',') != std::string::npos && s.find('.') == std::string::npos) std::replace(s.begin(), s.end(), ',', '.');
-  char* end = nullptr;
-  const double v = std::strtod(s.c_str(), &end);
-  if (end != s.c_str() + s.size() || !std::isfinite(v)) return std::nullopt;
+std::optional<double> parse_number(const std::string& s) {
+  double v;
+  if (!parse_export_number(s, true, v)) return std::nullopt;
   return v;
-}
-
-bool contains(const std::string& s, const std::string& what) { return s.find(what) != std::string::npos; }
-
-// Unit in parentheses of a column or header name, lower case ("(MPa)" -> "mpa").
-std::string unit_of(const std::string& name) {
-  const size_t a = name.rfind('('), b = name.rfind(')');
-  if (a == std::string::npos || b == std::string::npos || b < a) return "";
-  return lower(trim(name.substr(a + 1, b - a - 1)));
-}
-
-// Factor to Pa for a stress unit; 0 if unknown.
-double stress_unit(const std::string& unit) {
-  if (unit == "mpa" || unit == "n/mm^2" || unit == "n/mm2" || unit == "n/mm²") return 1e6;
-  if (unit == "kpa") return 1e3;
-  if (unit == "pa" || unit == "n/m^2") return 1.0;
-  if (unit == "psi") return 6894.757;
-  return 0.0;
-}
-
-// Factor to a fraction for a strain unit; 0 if unknown.
-double strain_unit(const std::string& unit) {
-  if (unit.empty() || unit == "mm/mm" || unit == "-" || unit == "m/m") return 1.0;
-  if (unit == "%") return 0.01;
-  return 0.0;
-}
-
-double length_unit_mm(const std::string& unit) {
-  if (unit == "mm") return 1.0;
-  if (unit == "cm") return 10.0;
-  if (unit == "m") return 1000.0;
-  return 0.0;
-}
-
-double force_unit_n(const std::string& unit) {
-  if (unit == "n") return 1.0;
-  if (unit == "kn") return 1e3;
-  return 0.0;
-}
-
-double area_unit_mm2(const std::string& unit) {
-  if (unit == "mm^2" || unit == "mm2" || unit == "mm²") return 1.0;
-  if (unit == "cm^2" || unit == "cm2" || unit == "cm²") return 100.0;
-  if (unit == "m^2" || unit == "m2") return 1e6;
-  return 0.0;
 }
 
 }  // namespace
 
-TensileTest read_tensile_csv(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path, "cannot open the tensile-test file");
-  std::vector<std::string> lines;
-  for (std::string line; std::getline(in, line);) {
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    lines.push_back(line);
-  }
-  auto at = [&](size_t index) { return path + ":" + std::to_string(index + 1); };
-
-  // The data start at the first row whose first two fields are numbers; the column
-  // header is the last non-empty line before it; the lines above are the specimen block.
-  size_t data_start = lines.size();
-  for (size_t i = 0; i < lines.size(); ++i) {
-    const auto f = split_fields(lines[i]);
-    if (f.size() >= 2 && parse_number(f[0]) && parse_number(f[1])) {
-      data_start = i;
-      break;
-    }
-  }
-  if (data_start == lines.size())
-    throw InputError(path, "no numeric data rows found (expected a ';'-separated export)");
-  size_t header_line = data_start;
-  for (size_t i = data_start; i-- > 0;) {
-    const auto f = split_fields(lines[i]);
-    if (std::any_of(f.begin(), f.end(), [](const std::string& s) { return !s.empty(); })) {
-      header_line = i;
-      break;
-    }
-  }
-  if (header_line == data_start) throw InputError(at(data_start), "no column header line before the data");
-
+TensileTest tensile_test_from_export(const SpecimenExport& s) {
   TensileTest test;
-  test.file = path;
-  for (size_t i = 0; i < header_line; ++i) {
-    const auto f = split_fields(lines[i]);
-    if (f.size() >= 2 && !f[0].empty()) test.header[f[0]] = f[1];
-  }
-  test.material = std::filesystem::path(path).stem().string();
-  for (const auto& [key, value] : test.header)
-    if (lower(key) == "material" && !value.empty()) test.material = value;
-
-  // Identify columns.
-  const auto columns = split_fields(lines[header_line]);
-  std::optional<size_t> eng_strain, eng_stress, true_strain, true_stress, force, extension;
-  for (size_t c = 0; c < columns.size(); ++c) {
-    const std::string name = lower(columns[c]);
-    const bool is_true = contains(name, "true");
-    auto first = [c](std::optional<size_t>& slot) {
-      if (!slot) slot = c;
-    };
-    if (contains(name, "strain")) first(is_true ? true_strain : eng_strain);
-    if (contains(name, "stress")) first(is_true ? true_stress : eng_stress);
-    if (contains(name, "load") || contains(name, "force")) first(force);
-    if (contains(name, "extension") || contains(name, "displacement") || contains(name, "crosshead")) first(extension);
-  }
-  auto header_number = [&](const std::vector<std::string>& keys, double (*unit)(const std::string&), double& value) {
-    for (const auto& [key, text] : test.header) {
-      const std::string k = lower(key);
-      for (const auto& want : keys)
-        if (contains(k, want)) {
-          const auto v = parse_number(text);
-          const double factor = unit(unit_of(key));
-          if (v && factor > 0.0) {
-            value = *v * factor;
-            return true;
-          }
-        }
-    }
-    return false;
-  };
-  double gauge_mm = 0, area_mm2 = 0;
-  header_number({"gauge length", "specimen length", "gage length"}, length_unit_mm, gauge_mm);
-  if (!header_number({"cross-section", "cross section", "area"}, area_unit_mm2, area_mm2)) {
-    double width = 0, thickness = 0;
-    if (header_number({"width"}, length_unit_mm, width) && header_number({"thickness"}, length_unit_mm, thickness))
-      area_mm2 = width * thickness;
-  }
-
-  auto unknown_unit = [&](size_t c) {
-    return InputError(at(header_line), "column '" + columns[c] + "': unknown unit '" + unit_of(columns[c]) + "'");
-  };
-  std::vector<size_t> used;
-  std::function<void(const std::vector<double>&)> convert;
+  test.file = s.file;
+  test.header = s.header;
+  test.material = s.header_value("material");
+  if (test.material.empty()) test.material = s.label;
+  using Q = ExportQuantity;
+  const ExportColumn* eng_strain = s.find(Q::strain, "", {"true"});
+  const ExportColumn* eng_stress = s.find(Q::stress, "", {"true"});
+  const ExportColumn* true_strain = s.find(Q::strain, "true");
+  const ExportColumn* true_stress = s.find(Q::stress, "true");
+  const ExportColumn* extension = s.find(Q::displacement);
+  const ExportColumn* force = s.find(Q::force);
+  double gauge = 0, area = 0, width = 0, thickness = 0;
+  const bool has_gauge =
+      s.header_si("gauge length", gauge) || s.header_si("gage length", gauge) || s.header_si("specimen length", gauge);
+  const bool has_area =
+      s.header_si("cross-section", area) || s.header_si("cross section", area) || s.header_si("area", area) ||
+      (s.header_si("width", width) && s.header_si("thickness", thickness) && (area = width * thickness) > 0.0);
+  const size_t n = s.rows();
   if (eng_strain && eng_stress) {
-    const double fe = strain_unit(unit_of(columns[*eng_strain]));
-    const double fs = stress_unit(unit_of(columns[*eng_stress]));
-    if (fe == 0.0) throw unknown_unit(*eng_strain);
-    if (fs == 0.0) throw unknown_unit(*eng_stress);
-    used = {*eng_strain, *eng_stress};
-    test.conversion = "stretch = 1 + '" + columns[*eng_strain] + "', nominal stress = '" + columns[*eng_stress] +
+    test.conversion = "stretch = 1 + '" + eng_strain->label + "', nominal stress = '" + eng_stress->label +
                       "' (force / initial cross-section)";
-    convert = [&, fe, fs](const std::vector<double>& v) {
-      test.stretch.push_back(1.0 + fe * v[0]);
-      test.nominal_stress.push_back(fs * v[1]);
-    };
-  } else if (extension && force && gauge_mm > 0.0 && area_mm2 > 0.0) {
-    const double fl = length_unit_mm(unit_of(columns[*extension]));
-    const double ff = force_unit_n(unit_of(columns[*force]));
-    if (fl == 0.0) throw unknown_unit(*extension);
-    if (ff == 0.0) throw unknown_unit(*force);
-    used = {*extension, *force};
-    std::ostringstream s;
-    s << "stretch = 1 + '" << columns[*extension] << "' / gauge length " << gauge_mm << " mm, nominal stress = '"
-      << columns[*force] << "' / cross-section " << area_mm2 << " mm^2";
-    test.conversion = s.str();
-    convert = [&, fl, ff, gauge_mm, area_mm2](const std::vector<double>& v) {
-      test.stretch.push_back(1.0 + fl * v[0] / gauge_mm);
-      test.nominal_stress.push_back(ff * v[1] / (area_mm2 * 1e-6));
-    };
+    for (size_t i = 0; i < n; ++i) {
+      test.stretch.push_back(1.0 + eng_strain->values[i]);
+      test.nominal_stress.push_back(eng_stress->values[i]);
+    }
+  } else if (extension && force && has_gauge && has_area && gauge > 0.0 && area > 0.0) {
+    std::ostringstream c;
+    c << "stretch = 1 + '" << extension->label << "' / gauge length " << gauge * 1e3 << " mm, nominal stress = '"
+      << force->label << "' / cross-section " << area * 1e6 << " mm^2";
+    test.conversion = c.str();
+    for (size_t i = 0; i < n; ++i) {
+      test.stretch.push_back(1.0 + extension->values[i] / gauge);
+      test.nominal_stress.push_back(force->values[i] / area);
+    }
   } else if (true_strain && true_stress) {
-    const double fe = strain_unit(unit_of(columns[*true_strain]));
-    const double fs = stress_unit(unit_of(columns[*true_stress]));
-    if (fe == 0.0) throw unknown_unit(*true_strain);
-    if (fs == 0.0) throw unknown_unit(*true_stress);
-    used = {*true_strain, *true_stress};
-    test.conversion = "stretch = exp('" + columns[*true_strain] + "'), nominal stress = '" + columns[*true_stress] +
+    test.conversion = "stretch = exp('" + true_strain->label + "'), nominal stress = '" + true_stress->label +
                       "' / stretch (incompressible)";
-    convert = [&, fe, fs](const std::vector<double>& v) {
-      const double lambda = std::exp(fe * v[0]);
+    for (size_t i = 0; i < n; ++i) {
+      const double lambda = std::exp(true_strain->values[i]);
       test.stretch.push_back(lambda);
-      test.nominal_stress.push_back(fs * v[1] / lambda);
-    };
+      test.nominal_stress.push_back(true_stress->values[i] / lambda);
+    }
   } else {
     std::string found;
-    for (const auto& c : columns)
-      if (!c.empty()) found += (found.empty() ? "'" : ", '") + c + "'";
-    throw InputError(at(header_line),
-                     "no usable stress-strain columns: need 'Engineering Strain' and 'Engineering Stress', or "
-                     "'Extension' and 'Load' with the specimen length and cross-section in the header block, or "
-                     "'True Strain' and 'True Stress'; found columns " +
+    for (const auto& c : s.columns) found += (found.empty() ? "'" : ", '") + c.label + "'";
+    throw InputError(s.where(),
+                     "no usable stress-strain columns: need an engineering strain and stress, or an extension and "
+                     "a load with the specimen length and cross-section in the header block, or a true strain and "
+                     "stress; found columns " +
                          found);
   }
-
-  std::vector<double> values(used.size());
-  for (size_t i = data_start; i < lines.size(); ++i) {
-    const auto f = split_fields(lines[i]);
-    if (std::all_of(f.begin(), f.end(), [](const std::string& s) { return s.empty(); })) continue;
-    for (size_t k = 0; k < used.size(); ++k) {
-      const size_t c = used[k];
-      if (c >= f.size() || f[c].empty()) throw InputError(at(i), "missing value in column '" + columns[c] + "'");
-      const auto v = parse_number(f[c]);
-      if (!v) throw InputError(at(i), "column '" + columns[c] + "': '" + f[c] + "' is not a number");
-      values[k] = *v;
-    }
-    convert(values);
-  }
-  if (test.stretch.size() < 2) throw InputError(path, "fewer than two data rows");
+  if (test.stretch.size() < 2) throw InputError(s.where(), "fewer than two data rows");
   return test;
+}
+
+std::vector<TensileTest> read_tensile_tests(const std::string& path) {
+  std::vector<TensileTest> tests;
+  for (const auto& block : read_test_machine_export(path)) tests.push_back(tensile_test_from_export(block));
+  return tests;
+}
+
+TensileTest read_tensile_csv(const std::string& path) {
+  auto tests = read_tensile_tests(path);
+  return tests.front();
 }
 
 // ---------------------------------------------------------------------------------
@@ -281,6 +128,14 @@ double rms_error(const std::vector<double>& stretch, const std::vector<double>& 
   double sum = 0;
   for (size_t i = 0; i < stretch.size(); ++i) sum += std::pow(model(stretch[i]) - P[i], 2);
   return std::sqrt(sum / static_cast<double>(stretch.size()));
+}
+
+// R^2 = 1 - SS_res / SS_tot with SS_res = n rms^2, SS_tot = sum (P - mean P)^2.
+double r_squared(const std::vector<double>& P, double rms) {
+  double mean = 0, ss_tot = 0;
+  for (double p : P) mean += p / static_cast<double>(P.size());
+  for (double p : P) ss_tot += (p - mean) * (p - mean);
+  return ss_tot > 0.0 ? 1.0 - static_cast<double>(P.size()) * rms * rms / ss_tot : 0.0;
 }
 
 void check_fit_data(const std::vector<double>& stretch, const std::vector<double>& P, size_t unknowns) {
@@ -316,6 +171,7 @@ FitResult fit_neo_hookean(const std::vector<double>& stretch, const std::vector<
   r.small_strain_mu = r.values[0];
   r.stable = r.values[0] > 0.0;
   r.rms = rms_error(stretch, P, [&](double l) { return uniaxial_stress_neo_hookean(l, r.values[0]); });
+  r.r2 = r_squared(P, r.rms);
   return r;
 }
 
@@ -339,6 +195,7 @@ FitResult fit_yeoh(const std::vector<double>& stretch, const std::vector<double>
   r.stable = c(0) > 0.0;
   for (double x = 0; x <= 7.0; x += 0.01) r.stable = r.stable && c(0) + 2.0 * c(1) * x + 3.0 * c(2) * x * x > 0.0;
   r.rms = rms_error(stretch, P, [&](double l) { return uniaxial_stress_yeoh(l, c(0), c(1), c(2)); });
+  r.r2 = r_squared(P, r.rms);
   return r;
 }
 
@@ -472,6 +329,7 @@ FitResult fit_ogden(const std::vector<double>& stretch, const std::vector<double
     r.stable = r.stable && mu[p] * alpha[p] > 0.0;
   }
   r.rms = rms_error(stretch, P, [&](double l) { return uniaxial_stress_ogden(l, mu, alpha); });
+  r.r2 = r_squared(P, r.rms);
   return r;
 }
 
@@ -536,8 +394,11 @@ int fit_materials_main(const std::vector<std::string>& args, const std::string& 
   std::ostringstream curves;
   curves << "material,stretch,data_nominal_stress_pa,neo_hookean_pa,yeoh_pa,ogden1_pa,ogden2_pa,ogden3_pa\n";
   curves << std::setprecision(10);
-  for (const auto& file : files) {
-    const TensileTest test = read_tensile_csv(file);
+  std::vector<TensileTest> tests;  // every specimen block of every file
+  for (const auto& file : files)
+    for (auto& t : read_tensile_tests(file)) tests.push_back(std::move(t));
+  for (const TensileTest& test : tests) {
+    const std::string& file = test.file;
     std::vector<double> stretch, P;
     select_strain_range(test, max_strain, stretch, P);
     std::vector<FitResult> fits = {fit_neo_hookean(stretch, P), fit_yeoh(stretch, P)};
@@ -552,6 +413,7 @@ int fit_materials_main(const std::vector<std::string>& args, const std::string& 
         j.add("model", f.model)
             .add("coefficients", c)
             .add("rms_pa", f.rms)
+            .add("r2", f.r2)
             .add("small_strain_mu_pa", f.small_strain_mu)
             .add("stable", f.stable)
             .add("converged", f.converged);
@@ -572,7 +434,7 @@ int fit_materials_main(const std::vector<std::string>& args, const std::string& 
           << "  fitted range: engineering strain <= " << max_strain << " -> stretch " << std::setprecision(4)
           << stretch.front() << " .. " << stretch.back() << ", " << stretch.size() << " points\n";
       out << "  " << std::left << std::setw(14) << "model" << std::setw(64) << "coefficients [Pa; alpha -]"
-          << std::right << std::setw(10) << "RMS [kPa]" << std::setw(12) << "mu0 [kPa]"
+          << std::right << std::setw(10) << "RMS [kPa]" << std::setw(9) << "R^2" << std::setw(12) << "mu0 [kPa]"
           << "  stable\n";
       for (const auto& f : fits) {
         std::ostringstream c;
@@ -581,9 +443,9 @@ int fit_materials_main(const std::vector<std::string>& args, const std::string& 
         std::string label = f.model;
         if (f.model == "ogden") label += " N=" + std::to_string(f.names.size() / 2);
         out << "  " << std::left << std::setw(14) << label << std::setw(64) << c.str() << std::right << std::fixed
-            << std::setprecision(3) << std::setw(10) << f.rms / 1e3 << std::setw(12) << std::setprecision(2)
-            << f.small_strain_mu / 1e3 << "  " << (f.stable ? "yes" : "NO") << (f.converged ? "" : " (not converged)")
-            << "\n"
+            << std::setprecision(3) << std::setw(10) << f.rms / 1e3 << std::setprecision(5) << std::setw(9) << f.r2
+            << std::setw(12) << std::setprecision(2) << f.small_strain_mu / 1e3 << "  " << (f.stable ? "yes" : "NO")
+            << (f.converged ? "" : " (not converged)") << "\n"
             << std::defaultfloat;
       }
       out << "\n";

@@ -1,8 +1,8 @@
 // Calibration of hyperelastic laws from uniaxial tensile tests.
 //
-// Input: Instron-style CSV exports (';'-separated): a header block of specimen
-// parameters ("Specimen Length (mm);33", "Specimen Cross-section (cm^2);0.18", ...),
-// a column header line, then numeric rows. Conversion to stretch lambda and nominal
+// Input: test-machine exports read by core/test_machine_export.h: a header block of
+// specimen parameters ("Specimen Length (mm);33", "Specimen Cross-section (cm^2);0.18",
+// ...), column names with units, then numeric rows (converted to SI). Conversion to stretch lambda and nominal
 // (first Piola-Kirchhoff) stress P, in order of preference:
 //   1. engineering strain + engineering stress columns: lambda = 1 + strain,
 //      P = engineering stress (= force / initial cross-section);
@@ -10,7 +10,7 @@
 //      P = force / initial cross-section (both from the header block);
 //   3. true (logarithmic) strain + true stress: lambda = exp(true strain),
 //      P = true stress / lambda (incompressible: A = A0 / lambda).
-// Units are taken from the column names: %, MPa, kPa, Pa, N/mm^2, N, kN, mm.
+// Engineering columns are those whose name does not contain "true".
 //
 // Fits (incompressible uniaxial tension, lambda_2 = lambda_3 = lambda^(-1/2)):
 //   P = 2 (lambda - lambda^-2) (dW/dI1 + dW/dI2 / lambda),
@@ -26,6 +26,8 @@
 #include <string>
 #include <vector>
 
+#include "core/test_machine_export.h"
+
 namespace morphfem {
 
 struct TensileTest {
@@ -37,8 +39,12 @@ struct TensileTest {
   std::vector<double> nominal_stress;         // P [Pa]
 };
 
-// Reads an export; bad files throw InputError naming the file and line.
+// Reads an export with the test-machine reader (core/test_machine_export.h: any
+// separator, decimal commas, units row or units in names); bad files throw
+// InputError naming the file and line. read_tensile_csv: the first specimen block.
 TensileTest read_tensile_csv(const std::string& path);
+std::vector<TensileTest> read_tensile_tests(const std::string& path);
+TensileTest tensile_test_from_export(const SpecimenExport& specimen);
 
 // Incompressible uniaxial nominal stress [Pa] of the laws (closed forms above).
 double uniaxial_stress_neo_hookean(double lambda, double mu);
@@ -50,6 +56,7 @@ struct FitResult {
   std::vector<std::string> names;  // coefficient names: mu | c1 c2 c3 | mu1 alpha1 ...
   std::vector<double> values;      // [Pa] for moduli, [-] for exponents
   double rms = 0;                  // RMS error of P [Pa]
+  double r2 = 0;                   // coefficient of determination 1 - SS_res / SS_tot [-]
   double small_strain_mu = 0;      // small-strain shear modulus [Pa]
   bool stable = true;              // usable as a law (Yeoh: dW/dI1 > 0 up to x = 7; Ogden: mu_p alpha_p > 0)
   bool converged = true;           // iterative fits only

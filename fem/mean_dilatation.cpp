@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 
 #include "core/errors.h"
 
@@ -104,6 +105,10 @@ double MeanDilatationTerm::piece(int k, const PieceState& s, Eigen::VectorXd* g,
     *H += dU * d2v;
   }
   return energy;
+}
+
+void MeanDilatationTerm::set_growth(int, GrowthFunction) {
+  throw std::invalid_argument("growth (active strain) is not available with the mean_dilatation formulation");
 }
 
 }  // namespace morphfem

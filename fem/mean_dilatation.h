@@ -36,6 +36,8 @@ class MeanDilatationTerm : public ElasticTerm {
                      std::vector<std::shared_ptr<const Material>> materials, int quadrature_degree = 0);
 
   double piece(int k, const PieceState& s, Eigen::VectorXd* g, Eigen::MatrixXd* H) const override;
+  // Growth is not implemented for the mixed formulation: refused.
+  void set_growth(int region, GrowthFunction growth) override;
 
   // Reference volume V_e [m^3] and volume ratio Theta_e = v_e / V_e of piece k.
   void dilatation(const PieceState& s, double& reference_volume, double& theta) const;

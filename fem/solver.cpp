@@ -90,14 +90,7 @@ QuasiStaticSolver::QuasiStaticSolver(Assembler& assembler, std::vector<Dirichlet
     PETSC_CHECK(KSPSetType(ksp, J_ ? KSPGMRES : KSPCG));
     PETSC_CHECK(PCSetType(pc, PCGAMG));
     PETSC_CHECK(KSPSetTolerances(ksp, 1e-10, 1e-50, PETSC_DEFAULT, 2000));
-    // Rigid-body modes from the reference coordinates of the owned nodes.
-    Vec coords = assembler_.create_vector();
-    assembler_.scatter_all(assembler_.mesh().X, coords);
-    MatNullSpace near_null;
-    PETSC_CHECK(MatNullSpaceCreateRigidBody(coords, &near_null));
-    PETSC_CHECK(MatSetNearNullSpace(H_, near_null));
-    PETSC_CHECK(MatNullSpaceDestroy(&near_null));
-    PETSC_CHECK(VecDestroy(&coords));
+    attach_near_nullspace();
   } else {
     throw InputError("solver.linear_solver",
                      "unknown linear solver '" + opt_.linear_solver + "' (allowed: mumps, gamg)");
@@ -134,6 +127,21 @@ void QuasiStaticSolver::set_jacobian() {
   }
 }
 
+// Rigid-body modes from the reference coordinates of the owned nodes (GAMG).
+void QuasiStaticSolver::attach_near_nullspace() {
+  Vec coords = assembler_.create_vector();
+  assembler_.scatter_all(assembler_.mesh().X, coords);
+  MatNullSpace near_null;
+  PETSC_CHECK(MatNullSpaceCreateRigidBody(coords, &near_null));
+  PETSC_CHECK(MatSetNearNullSpace(H_, near_null));
+  PETSC_CHECK(MatNullSpaceDestroy(&near_null));
+  PETSC_CHECK(VecDestroy(&coords));
+}
+
+// A term whose pieces changed (self-contact candidates) makes the assembler
+// rebuild its ghost scatter and nonzero pattern; the Hessian is re-created with
+// the new pattern and handed to SNES (the linear solver re-factors it anyway at
+// the next Newton iteration). Terms that never change keep everything as it was.
 void QuasiStaticSolver::refresh_pieces() {
   int changed = 0;
   for (const auto& term : assembler_.terms()) changed |= term->refresh_pieces(assembler_, u_) ? 1 : 0;
@@ -143,7 +151,9 @@ void QuasiStaticSolver::refresh_pieces() {
   assembler_.setup();
   PETSC_CHECK(MatDestroy(&H_));
   H_ = assembler_.create_matrix();
+  if (opt_.linear_solver == "gamg") attach_near_nullspace();
   set_jacobian();
+  ++pattern_rebuilds_;
 }
 
 void QuasiStaticSolver::clear_low_rank() {

@@ -75,6 +75,8 @@ class QuasiStaticSolver {
   Vec solution() const { return u_; }
   double time() const { return t_; }
   Assembler& assembler() { return assembler_; }
+  // How often a term's refresh_pieces asked for a new assembly pattern.
+  int pattern_rebuilds() const { return pattern_rebuilds_; }
 
   // PETSc callbacks (public for the C trampolines).
   PetscErrorCode line_search(SNESLineSearch ls);
@@ -85,7 +87,8 @@ class QuasiStaticSolver {
  private:
   void apply_dirichlet(Vec u, double t) const;
   void set_jacobian();    // (re)attach the Hessian (and shell operator) to SNES
-  void refresh_pieces();  // lets terms rebuild state-dependent pieces
+  void refresh_pieces();  // lets terms rebuild state-dependent pieces (then a new pattern)
+  void attach_near_nullspace();
   bool solve_step(double t_new, int& newton_its, int& linear_its, std::string& why);
 
   Assembler& assembler_;
@@ -98,6 +101,7 @@ class QuasiStaticSolver {
   void clear_low_rank();
   SNES snes_ = nullptr;
   double t_ = 0.0, dt_prev_ = 0.0;
+  int pattern_rebuilds_ = 0;
   double fnorm0_ = 0.0, fnorm_scale_ = 0.0;
   double length_scale_ = 1.0;
   double advised_dt_ =

@@ -27,6 +27,7 @@
 
 #include "core/errors.h"
 #include "mesh/robot.h"
+#include "mesh/solid_shapes.h"
 
 namespace morphfem {
 
@@ -374,6 +375,8 @@ const std::map<std::string, GeometryBuilder>& geometry_registry() {
       {"cantilever", build_cantilever},
       {"robot_voxel", build_robot_voxel},
       {"robot_physical", build_robot_physical},
+      {"hemisphere", build_hemisphere},
+      {"solid_cylinder", build_solid_cylinder},
   };
   return registry;
 }

@@ -3,7 +3,8 @@
 // pieces enclose. Surfaces are named after meshing from a representative triangle of
 // each boundary surface entity: inside a cavity box -> that cavity's wall; outward
 // normal -z -> bottom (and a foot if it is the skin's bottom face in a foot band);
-// otherwise outer.
+// otherwise outer. The same outside surfaces are also split by material for
+// friction: the feet, bladder_surface (a bladder's faces) and skin_surface (the rest).
 #include "mesh/robot.h"
 
 #include <gmsh.h>
@@ -147,6 +148,7 @@ Mesh mesh_assembly(const Assembly& assembly, double mesh_size, int order, const 
 
   // Volumes: the piece containing each fragment's centre of mass gives its region.
   std::map<std::string, std::vector<int>> volume_tags;
+  std::map<int, std::string> region_of_volume;
   gmsh::vectorpair volumes;
   gmsh::model::getEntities(volumes, 3);
   for (const auto& [dim, tag] : volumes) {
@@ -156,6 +158,7 @@ Mesh mesh_assembly(const Assembly& assembly, double mesh_size, int order, const 
                               [&](const Piece& p) { return p.box.contains(Vec3(x, y, z), tol); });
     if (piece == assembly.pieces.end()) throw std::logic_error("robot geometry: a fragment lies in no piece");
     volume_tags[piece->region].push_back(tag);
+    region_of_volume[tag] = piece->region;
   }
   for (const std::string& name : assembly.volume_order) add_group(3, volume_tags[name], name);
 
@@ -174,24 +177,33 @@ Mesh mesh_assembly(const Assembly& assembly, double mesh_size, int order, const 
       surface_tags[cavity->surface].push_back(tag);
       continue;
     }
+    // Outside surfaces by material, for friction: a bladder's, or the skin's other than the feet.
+    const bool bladder = region_of_volume.at(up[0]).rfind("bladder_", 0) == 0;
+    bool foot = false;
     Vec3 step = Vec3::Zero();
     step(s.axis) = probe;
     const bool solid_below = inside_solid(assembly, s.point - step),
                solid_above = inside_solid(assembly, s.point + step);
     if (solid_below == solid_above) throw std::logic_error("robot geometry: cannot orient a boundary surface");
     const bool faces_down = s.axis == 2 && solid_above;
-    if (!faces_down) {
-      surface_tags["outer"].push_back(tag);
-      continue;
+    surface_tags[faces_down ? "bottom" : "outer"].push_back(tag);
+    if (faces_down && std::abs(s.nodes.hi.z() - assembly.foot_z) <= tol &&
+        std::abs(s.nodes.lo.z() - assembly.foot_z) <= tol) {
+      if (s.nodes.hi.y() <= assembly.foot_length + tol) {
+        surface_tags["foot_a"].push_back(tag);
+        foot = true;
+      }
+      if (s.nodes.lo.y() >= assembly.length - assembly.foot_length - tol) {
+        surface_tags["foot_b"].push_back(tag);
+        foot = true;
+      }
     }
-    surface_tags["bottom"].push_back(tag);
-    if (std::abs(s.nodes.hi.z() - assembly.foot_z) > tol || std::abs(s.nodes.lo.z() - assembly.foot_z) > tol) continue;
-    if (s.nodes.hi.y() <= assembly.foot_length + tol) surface_tags["foot_a"].push_back(tag);
-    if (s.nodes.lo.y() >= assembly.length - assembly.foot_length - tol) surface_tags["foot_b"].push_back(tag);
+    if (!foot) surface_tags[bladder ? "bladder_surface" : "skin_surface"].push_back(tag);
   }
   std::vector<std::string> surface_order;
   for (const Cavity& c : assembly.cavities) surface_order.push_back(c.surface);
-  for (const char* name : {"bottom", "foot_a", "foot_b", "outer"}) surface_order.push_back(name);
+  for (const char* name : {"bottom", "foot_a", "foot_b", "outer", "skin_surface", "bladder_surface"})
+    surface_order.push_back(name);
   for (const std::string& name : surface_order) add_group(2, surface_tags[name], name);
 
   return mesh_from_current_gmsh_model(source);

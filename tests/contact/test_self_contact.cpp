@@ -1,10 +1,14 @@
-// Self-contact kernel: point-triangle distance against dense sampling, and the
-// barrier's gradient and Hessian against finite differences for every closest
-// feature (face, edge, vertex); candidate search on a thin plate (P1 and P2).
+// Self-contact kernels: point-triangle and edge-edge distances against dense
+// sampling, and the barriers' gradients and Hessians against finite differences
+// for every closest feature (face, edge, vertex; line-line, point-line,
+// point-point) including near-parallel edges (mollifier active); candidate search
+// on a thin plate (P1 and P2); two wedges whose edges cross with no vertex near a
+// face (only the edge-edge pairs see it).
 #include <gtest/gtest.h>
 
 #include <random>
 
+#include "contact/barrier.h"
 #include "contact/self_contact.h"
 #include "mesh/geometry.h"
 
@@ -117,5 +121,221 @@ TEST(SelfContactTerm, FindsCandidatesAcrossAThinPlateOnP1AndP2) {
       for (size_t a = 0; a < nodes.size(); ++a) s.X.row(a) = mesh.X.row(nodes[a]);
       EXPECT_EQ(term.piece(k, s, nullptr, nullptr), 0.0);
     }
+  }
+}
+
+namespace {
+
+// Central finite differences of a 4 x 3 kernel's energy and gradient against its
+// analytic gradient and Hessian, at step h [m].
+template <class Kernel>
+void expect_derivatives_match(const Eigen::Matrix<double, 4, 3>& x, double h, Kernel&& kernel,
+                              const std::string& what) {
+  Eigen::VectorXd g;
+  Eigen::MatrixXd H;
+  const double e = kernel(x, &g, &H);
+  ASSERT_TRUE(std::isfinite(e) && e > 0) << what;
+  Eigen::VectorXd g_fd(12);
+  Eigen::MatrixXd H_fd(12, 12);
+  for (int j = 0; j < 12; ++j) {
+    Eigen::Matrix<double, 4, 3> xp = x, xm = x;
+    xp(j / 3, j % 3) += h;
+    xm(j / 3, j % 3) -= h;
+    Eigen::VectorXd gp, gm;
+    g_fd[j] = (kernel(xp, &gp, nullptr) - kernel(xm, &gm, nullptr)) / (2 * h);
+    H_fd.col(j) = (gp - gm) / (2 * h);
+  }
+  EXPECT_LT((g - g_fd).norm(), 1e-6 * g.norm()) << what;
+  EXPECT_LT((H - H_fd).norm(), 1e-5 * H.norm()) << what;
+  EXPECT_LT((H - H.transpose()).norm(), 1e-10 * H.norm()) << what;
+  // Translation invariance: the gradient sums to zero over the four nodes.
+  EXPECT_LT((g.segment<3>(0) + g.segment<3>(3) + g.segment<3>(6) + g.segment<3>(9)).norm(), 1e-9 * g.norm()) << what;
+}
+
+// Edge a along x (length 1e-2) and edge b at distance ~d: crossing skew edges
+// (closest points interior: line-line), b's end near a's interior (point-line),
+// end near end (point-point), or b at angle `angle` [rad] to a (near-parallel).
+Eigen::Matrix<double, 4, 3> edge_configuration(const std::string& kind, double d, double angle, std::mt19937& rng) {
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  Eigen::Matrix<double, 4, 3> x;
+  x.row(0) << 0, 0, 0;
+  x.row(1) << 1, 0, 0;
+  if (kind == "line-line") {
+    x.row(2) << 0.4, -0.5, d / 1e-2;
+    x.row(3) << 0.6, 0.5, d / 1e-2;
+  } else if (kind == "point-line") {
+    x.row(2) << 0.5, 0.0, d / 1e-2;
+    x.row(3) << 0.5, 0.6, 0.8 + d / 1e-2;
+  } else if (kind == "point-point") {
+    x.row(2) << 1.0 + 0.6 * d / 1e-2, 0.0, 0.8 * d / 1e-2;
+    x.row(3) << 1.8, 0.4, 0.9;
+  } else {  // near-parallel: b over the middle of a, turned by `angle` about z
+    x.row(2) << 0.5 - 0.4 * std::cos(angle), -0.4 * std::sin(angle), d / 1e-2;
+    x.row(3) << 0.5 + 0.4 * std::cos(angle), 0.4 * std::sin(angle), d / 1e-2;
+  }
+  x *= 1e-2;
+  // Small random perturbation. Near-parallel lines: a tilt tau moves their closest
+  // points by ~ tau d / angle^2 along them, so it shrinks with angle^2 to keep the
+  // closest points interior (away from the C1-only switch to point-line).
+  const double size = kind == "parallel" ? 1e-3 * d * std::pow(angle / 0.1, 2) : 1e-3 * d;
+  for (int a = 0; a < 4; ++a)
+    for (int i = 0; i < 3; ++i) x(a, i) += size * unit(rng);
+  return x;
+}
+
+}  // namespace
+
+TEST(SelfContactKernel, EdgeEdgeDistanceMatchesDenseSampling) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  for (int trial = 0; trial < 60; ++trial) {
+    Eigen::Matrix<double, 4, 3> x;
+    for (int a = 0; a < 4; ++a)
+      for (int i = 0; i < 3; ++i) x(a, i) = unit(rng);
+    if (trial % 3 == 0) x.row(3) = x.row(2) + (x.row(1) - x.row(0)) * (0.5 + 0.5 * unit(rng));  // parallel
+    double best = std::numeric_limits<double>::infinity();
+    const int n = 400;
+    for (int i = 0; i <= n; ++i)
+      for (int j = 0; j <= n; ++j) {
+        const Eigen::RowVector3d pa = x.row(0) + (double(i) / n) * (x.row(1) - x.row(0));
+        const Eigen::RowVector3d pb = x.row(2) + (double(j) / n) * (x.row(3) - x.row(2));
+        best = std::min(best, (pa - pb).norm());
+      }
+    const double d = edge_edge_distance(x);
+    EXPECT_LE(d, best + 1e-12) << trial;
+    EXPECT_GT(d, best - 1e-2) << trial;
+  }
+}
+
+TEST(SelfContactKernel, EdgeEdgeBarrierGradientAndHessianMatchFiniteDifferences) {
+  std::mt19937 rng(6);
+  const double dhat = 1e-3, kappa = 1e6, area = 2e-5;
+  for (const std::string kind : {"line-line", "point-line", "point-point", "parallel"})
+    for (double s : {0.05, 0.3, 0.7, 0.95}) {
+      // Near-parallel: angles where c = |e_a x e_b|^2 lies below eps (mollified)
+      // and above it; eps = 1e-3 |E_a|^2 |E_b|^2 <=> sin(angle) ~ 0.032.
+      for (double angle : kind == "parallel" ? std::vector<double>{0.002, 0.01, 0.025, 0.1} : std::vector<double>{0}) {
+        const Eigen::Matrix<double, 4, 3> x = edge_configuration(kind, s * dhat, angle, rng);
+        const double eps = edge_edge_mollifier_threshold(x);
+        const std::string what = kind + " s=" + std::to_string(s) + " angle=" + std::to_string(angle);
+        EXPECT_NEAR(edge_edge_distance(x), s * dhat, 0.02 * s * dhat) << what;
+        expect_derivatives_match(
+            x, 1e-6 * s * dhat,
+            [&](const Eigen::Matrix<double, 4, 3>& y, Eigen::VectorXd* g, Eigen::MatrixXd* H) {
+              return edge_edge_barrier(y, area, kappa, dhat, eps, g, H);
+            },
+            what);
+      }
+    }
+}
+
+TEST(SelfContactKernel, EdgeEdgeMollifierVanishesForParallelEdgesAndIsOneBeyondThreshold) {
+  std::mt19937 rng(7);
+  const double dhat = 1e-3, kappa = 1e6, area = 2e-5;
+  // Exactly parallel (no perturbation): m(0) = 0, so no energy (the point-triangle
+  // pairs carry parallel contact); well beyond eps the full barrier.
+  Eigen::Matrix<double, 4, 3> x;
+  x << 0, 0, 0, 1e-2, 0, 0, 2e-3, 0, 0.5 * dhat, 8e-3, 0, 0.5 * dhat;
+  EXPECT_EQ(edge_edge_barrier(x, area, kappa, dhat, edge_edge_mollifier_threshold(x), nullptr, nullptr), 0.0);
+  const Eigen::Matrix<double, 4, 3> y = edge_configuration("line-line", 0.5 * dhat, 0, rng);
+  const double d = edge_edge_distance(y);
+  double phi, dphi, d2phi;
+  log_barrier(d / dhat, phi, &dphi, &d2phi);
+  EXPECT_NEAR(edge_edge_barrier(y, area, kappa, dhat, edge_edge_mollifier_threshold(y), nullptr, nullptr),
+              area * kappa * dhat * phi, 1e-12 * area * kappa * dhat * phi);
+  // Intersecting edges (exact binary coordinates, d = 0 exactly): outside the domain.
+  const double q = 1.0 / 128;
+  Eigen::Matrix<double, 4, 3> z;
+  z << 0, 0, 0, 2 * q, 0, 0, q, -q, -q, q, q, q;
+  EXPECT_TRUE(std::isinf(edge_edge_barrier(z, area, kappa, dhat, edge_edge_mollifier_threshold(z), nullptr, nullptr)));
+}
+
+namespace {
+
+// Two P1 tetrahedra: wedge "a" with its top edge on the x axis (z = 0), wedge "b"
+// with its bottom edge along y at height `gap` above it; their surfaces are the
+// regions "a" and "b". Moving b down by 2 gap makes the two edges cross while
+// b's vertices stay far from a's faces.
+Mesh crossing_wedges(double gap) {
+  Mesh mesh;
+  mesh.order = 1;
+  mesh.X.resize(8, 3);
+  mesh.X << -1, 0, 0, 1, 0, 0, 0, -0.5, -1, 0, 0.5, -1,  //
+      0, -1, gap, 0, 1, gap, -0.5, 0, gap + 1, 0.5, 0, gap + 1;
+  mesh.X *= 1e-2;
+  mesh.cells.resize(2, 4);
+  mesh.cells << 0, 1, 2, 3, 4, 5, 6, 7;
+  // Orient each cell positively and each face outward.
+  for (int c = 0; c < 2; ++c) {
+    const Eigen::Vector3d x0 = mesh.X.row(mesh.cells(c, 0)), x1 = mesh.X.row(mesh.cells(c, 1)),
+                          x2 = mesh.X.row(mesh.cells(c, 2)), x3 = mesh.X.row(mesh.cells(c, 3));
+    if ((x1 - x0).cross(x2 - x0).dot(x3 - x0) < 0) std::swap(mesh.cells(c, 2), mesh.cells(c, 3));
+  }
+  mesh.cell_region = {0, 0};
+  mesh.faces.resize(8, 3);
+  mesh.face_region.clear();
+  const int local[4][3] = {{0, 2, 1}, {0, 1, 3}, {1, 2, 3}, {0, 3, 2}};  // outward for a positive tet
+  for (int c = 0; c < 2; ++c)
+    for (int f = 0; f < 4; ++f) {
+      for (int a = 0; a < 3; ++a) mesh.faces(4 * c + f, a) = mesh.cells(c, local[f][a]);
+      mesh.face_region.push_back(1 + c);
+    }
+  mesh.regions = {{"body", 3, 0}, {"a", 2, 1}, {"b", 2, 2}};
+  return mesh;
+}
+
+// Total energy of a term's pieces at displacement u (n_nodes x 3).
+double term_energy(const EnergyTerm& term, const Mesh& mesh, const RowMatrixXd& u) {
+  double total = 0;
+  std::vector<int> nodes;
+  for (int k = 0; k < term.n_pieces(); ++k) {
+    term.piece_nodes(k, nodes);
+    PieceState s;
+    s.X.resize(nodes.size(), 3);
+    s.u.resize(nodes.size(), 3);
+    for (size_t a = 0; a < nodes.size(); ++a) {
+      s.X.row(a) = mesh.X.row(nodes[a]);
+      s.u.row(a) = u.row(nodes[a]);
+    }
+    total += term.piece(k, s, nullptr, nullptr);
+  }
+  return total;
+}
+
+}  // namespace
+
+TEST(SelfContactTerm, EdgePairsStopCrossingEdgesThatNoVertexSees) {
+  const double gap = 2e-4;
+  const Mesh mesh = crossing_wedges(gap / 1e-2);
+  Partition part;
+  part.cell_part.assign(mesh.n_cells(), 0);
+  part.node_begin = {0, mesh.n_nodes()};
+  for (bool edges : {false, true}) {
+    SelfContactSpec spec;
+    spec.pairs = {{"a", "b"}};
+    spec.dhat = 1e-4;
+    spec.kappa = 1e6;
+    spec.inflation = 1e-3;
+    spec.edge_edge = edges;
+    SelfContactTerm term(mesh, part, 0, spec);
+    EXPECT_EQ(term.n_edge_pairs() > 0, edges);
+    // b moves down through a by 2 gap (inside the trust radius r/2 = 5e-4 m).
+    RowMatrixXd u = RowMatrixXd::Zero(mesh.n_nodes(), 3);
+    u.block(4, 2, 4, 1).setConstant(-2 * gap);
+    // The end state has every vertex far from the other wedge's faces ...
+    double min_pt = std::numeric_limits<double>::infinity();
+    for (int k = 0; k < term.n_pairs(); ++k) {
+      std::vector<int> nodes;
+      term.piece_nodes(k, nodes);
+      Eigen::Matrix<double, 4, 3> x;
+      for (int a = 0; a < 4; ++a) x.row(a) = mesh.X.row(nodes[a]) + u.row(nodes[a]);
+      min_pt = std::min(min_pt, point_triangle_distance(x));
+    }
+    EXPECT_GT(min_pt, spec.dhat);
+    EXPECT_EQ(term_energy(term, mesh, u), 0.0);  // (a check of end states alone misses the crossing)
+    // ... but on the way the edges meet at half the motion: only edge pairs see it.
+    const double e_half = term_energy(term, mesh, 0.5 * u);
+    EXPECT_EQ(std::isinf(e_half), edges) << "edge_edge " << edges;
+    EXPECT_EQ(term_energy(term, mesh, 0.45 * u) > 0, edges) << "edge_edge " << edges;
   }
 }

@@ -163,3 +163,53 @@ TEST(BodyForce, GravityWorkEqualsWeightTimesCentroidDrop) {
     EXPECT_NEAR(term.piece(0, s, nullptr, nullptr), -b.z() * (-0.01) * V, 1e-12);  // E = -b.u V
   }
 }
+
+namespace {
+
+std::shared_ptr<const Material> yeoh_for_growth() {
+  ParamSet p("test");
+  p.set_string("model", "yeoh");
+  p.set("c1", 2e4);
+  p.set("c2", 3e3);
+  p.set("c3", 1e2);
+  p.set("kappa", 2e6);
+  return make_material(p);
+}
+
+}  // namespace
+
+TEST(Growth, GradientAndHessianMatchFiniteDifferences) {
+  for (int order : {1, 2}) {
+    Mesh mesh = single_tet(order, 5);
+    Partition part{1, {0}, {0, mesh.n_nodes()}};
+    ElasticTerm term(mesh, part, 0, {yeoh_for_growth()}, order == 1 ? 1 : 4);
+    term.set_growth(0, [](double t) { return Eigen::Vector3d(1.0 + 0.1 * t, 1.0 + 0.6 * t, 1.0 + 4.0 * t); });
+    term.set_time(0.7);
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> d(-1e-3, 1e-3);
+    PieceState s{mesh.X, Eigen::MatrixXd::NullaryExpr(mesh.n_nodes(), 3, [&]() { return d(rng); })};
+    Eigen::VectorXd g, g_fd;
+    Eigen::MatrixXd H, H_fd;
+    term.piece(0, s, &g, &H);
+    morphfem::testing::piece_finite_differences(term, 0, s, 1e-7, g_fd, H_fd);
+    EXPECT_LT((g - g_fd).norm(), 1e-6 * g.norm()) << "P" << order;
+    EXPECT_LT((H - H_fd).norm(), 1e-6 * H.norm()) << "P" << order;
+  }
+}
+
+TEST(Growth, GrownShapeIsStressFreeAndOthersAreNot) {
+  // u = (G - I) X makes F = G: zero energy and zero force; the undeformed state
+  // then carries the growth's strain energy.
+  Mesh mesh = single_tet(2, 3);
+  Partition part{1, {0}, {0, mesh.n_nodes()}};
+  ElasticTerm term(mesh, part, 0, {yeoh_for_growth()}, 4);
+  const Eigen::Vector3d stretch(1.115, 2.35, 12.5);  // the voxel study's inflated bladder at p = 0
+  term.set_growth(0, [&](double) { return stretch; });
+  PieceState s{mesh.X, mesh.X * (stretch - Eigen::Vector3d::Ones()).asDiagonal()};
+  Eigen::VectorXd g;
+  const double e = term.piece(0, s, &g, nullptr);
+  EXPECT_NEAR(e, 0.0, 1e-12);
+  EXPECT_LT(g.norm(), 1e-9);
+  s.u.setZero();
+  EXPECT_GT(term.piece(0, s, nullptr, nullptr), 1e-3);
+}

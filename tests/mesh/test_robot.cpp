@@ -121,7 +121,8 @@ void expect_voxel_robot(const Mesh& mesh) {
   std::vector<std::string> volumes = bladder_names("");
   volumes.push_back("skin");
   EXPECT_EQ(sorted(mesh.region_names(3)), sorted(volumes));
-  EXPECT_EQ(sorted(mesh.region_names(2)), sorted({"core_wall", "bottom", "foot_a", "foot_b", "outer"}));
+  EXPECT_EQ(sorted(mesh.region_names(2)),
+            sorted({"core_wall", "bottom", "foot_a", "foot_b", "outer", "skin_surface", "bladder_surface"}));
 
   // Region volumes: exact for straight-sided tetrahedra filling boxes.
   const double skin = 2 * kW * kL * kT + 2 * kEdge * kL * kGap + 2 * (kW - 2 * kEdge) * kSeal * kGap;
@@ -141,6 +142,15 @@ void expect_voxel_robot(const Mesh& mesh) {
   const auto [all_volume, all_residual] = enclosed_volume(mesh, {"core_wall", "bottom", "outer"});
   EXPECT_NEAR(all_volume, -(skin + 8 * bladder), 1e-10 * skin);
   EXPECT_LT(all_residual, 1e-14);
+  // The friction split of the same outside: feet + skin_surface + bladder_surface, once.
+  const auto [split_volume, split_residual] =
+      enclosed_volume(mesh, {"core_wall", "foot_a", "foot_b", "skin_surface", "bladder_surface"});
+  EXPECT_NEAR(split_volume, -(skin + 8 * bladder), 1e-10 * skin);
+  EXPECT_LT(split_residual, 1e-14);
+  // Every bladder_surface face belongs to a bladder cell; 4 lower + 4 upper blocks:
+  // each block's outside is its box minus the face glued to the skin.
+  const double block_faces = 2 * kBw * (kBy1 - kBy0) + 2 * (kBy1 - kBy0) * kHb + 2 * kBw * kHb;
+  EXPECT_NEAR(area(mesh, "bladder_surface"), 8 * (block_faces - kBw * (kBy1 - kBy0)), 1e-12);
 
   // Feet in the skin's bottom plane; bottom = lower bladders' bottoms + uncovered skin
   // bottom, which together cover the footprint once.
@@ -193,7 +203,8 @@ TEST(RobotGeometry, PhysicalPreset) {
   volumes.push_back("fabric");
   EXPECT_EQ(sorted(mesh.region_names(3)), sorted(volumes));
   std::vector<std::string> surfaces = bladder_names("_wall");
-  for (const char* name : {"core_wall", "bottom", "foot_a", "foot_b", "outer"}) surfaces.push_back(name);
+  for (const char* name : {"core_wall", "bottom", "foot_a", "foot_b", "outer", "skin_surface", "bladder_surface"})
+    surfaces.push_back(name);
   EXPECT_EQ(sorted(mesh.region_names(2)), sorted(surfaces));
 
   const double fabric = 2 * W * L * tf;

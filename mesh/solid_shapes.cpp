@@ -1,0 +1,180 @@
+// Solid shapes for contact verification (see solid_shapes.h): a refined hemisphere
+// (Hertz contact) and a solid cylinder or tube (rolling).
+#include "mesh/solid_shapes.h"
+
+#include <gmsh.h>
+
+#include <functional>
+#include <iomanip>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+#include "core/errors.h"
+#include "mesh/geometry.h"
+
+namespace morphfem {
+
+namespace {
+
+constexpr double kHuge = std::numeric_limits<double>::max();
+
+// A fresh gmsh model for one build, removed (with its size fields) when the scope ends.
+class ScopedShapeModel {
+ public:
+  explicit ScopedShapeModel(const std::string& name) {
+    initialize_gmsh();
+    gmsh::model::add(name);
+  }
+  ~ScopedShapeModel() { gmsh::model::remove(); }
+  ScopedShapeModel(const ScopedShapeModel&) = delete;
+  ScopedShapeModel& operator=(const ScopedShapeModel&) = delete;
+};
+
+// The same meshing options as the other builders (geometry.cpp): target size
+// mesh_size [m] at every CAD point, curved P2 mid-nodes, deterministic Delaunay 3-D.
+// A background size field, if set, can only refine below mesh_size.
+void generate_shape_mesh(double mesh_size, int order) {
+  gmsh::option::setNumber("Mesh.MeshSizeMin", 0.0);
+  gmsh::option::setNumber("Mesh.MeshSizeMax", mesh_size);
+  gmsh::option::setNumber("Mesh.MeshSizeFromCurvature", 0);
+  gmsh::option::setNumber("Mesh.ElementOrder", order);
+  gmsh::option::setNumber("Mesh.SecondOrderLinear", 0);
+  gmsh::option::setNumber("Mesh.HighOrderOptimize", 0);
+  gmsh::option::setNumber("Mesh.Algorithm3D", 1);
+  gmsh::vectorpair points;
+  gmsh::model::getEntities(points, 0);
+  gmsh::model::mesh::setSize(points, mesh_size);
+  gmsh::model::mesh::generate(3);
+}
+
+// Bounding box of the mesh nodes of one surface entity (tight, unlike CAD boxes).
+struct NodeBox {
+  Eigen::Vector3d min = Eigen::Vector3d::Constant(kHuge);
+  Eigen::Vector3d max = Eigen::Vector3d::Constant(-kHuge);
+};
+
+NodeBox surface_node_box(int tag) {
+  std::vector<std::size_t> tags;
+  std::vector<double> coords, parametric;
+  gmsh::model::mesh::getNodes(tags, coords, parametric, 2, tag, true, false);
+  NodeBox box;
+  for (std::size_t k = 0; k < tags.size(); ++k) {
+    const Eigen::Vector3d x(coords[3 * k], coords[3 * k + 1], coords[3 * k + 2]);
+    box.min = box.min.cwiseMin(x);
+    box.max = box.max.cwiseMax(x);
+  }
+  return box;
+}
+
+// Physical groups: every volume as "body"; each surface entity named by the first
+// rule its node box passes (rules in order, the last one should accept anything).
+using SurfaceNamer = std::vector<std::pair<std::string, std::function<bool(const NodeBox&)>>>;
+
+void name_regions(const SurfaceNamer& rules) {
+  gmsh::vectorpair volumes, surfaces;
+  gmsh::model::getEntities(volumes, 3);
+  gmsh::model::getEntities(surfaces, 2);
+  std::vector<int> volume_tags;
+  for (const auto& [dim, tag] : volumes) volume_tags.push_back(tag);
+  gmsh::model::setPhysicalName(3, gmsh::model::addPhysicalGroup(3, volume_tags), "body");
+  std::vector<std::vector<int>> members(rules.size());
+  for (const auto& [dim, tag] : surfaces) {
+    const NodeBox box = surface_node_box(tag);
+    std::size_t r = 0;
+    while (r < rules.size() && !rules[r].second(box)) ++r;
+    if (r == rules.size()) throw std::logic_error("solid shape: a boundary surface matches no naming rule");
+    members[r].push_back(tag);
+  }
+  for (std::size_t r = 0; r < rules.size(); ++r) {
+    if (members[r].empty()) throw std::logic_error("solid shape: no boundary surface named " + rules[r].first);
+    gmsh::model::setPhysicalName(2, gmsh::model::addPhysicalGroup(2, members[r]), rules[r].first);
+  }
+}
+
+std::string source_of(const ParamSet& params, const std::string& type) {
+  return params.context().empty() ? "geometry " + type : params.context();
+}
+
+}  // namespace
+
+Mesh build_hemisphere(const ParamSet& params) {
+  params.allow_only({"type", "mesh_size", "order", "radius", "contact_size", "refine_radius", "quarter"});
+  const double mesh_size = params.number_in("mesh_size", 1e-12, kHuge);
+  const int order = params.integer_in("order", 1, 2, 1);
+  const double radius = params.number_in("radius", 1e-12, kHuge);
+  const double contact_size = params.number_in("contact_size", 1e-12, mesh_size, mesh_size);
+  const double refine_radius = params.number_in("refine_radius", 0.0, radius, radius / 4);
+  const bool quarter = params.integer_in("quarter", 0, 1, 1) == 1;
+
+  ScopedShapeModel model("morphfem_hemisphere");
+  namespace occ = gmsh::model::occ;
+  // Lower half-ball (quarter: x, y >= 0) = ball intersected with a box below z = 0.
+  const double reach = 1.5 * radius;
+  const int box = quarter ? occ::addBox(0, 0, -reach, reach, reach, reach)
+                          : occ::addBox(-reach, -reach, -reach, 2 * reach, 2 * reach, reach);
+  gmsh::vectorpair half;
+  std::vector<gmsh::vectorpair> unused_map;
+  occ::intersect({{3, occ::addSphere(0, 0, 0, radius)}}, {{3, box}}, half, unused_map);
+  occ::synchronize();
+
+  // Size field: h = contact_size within r <= refine_radius of the pole (0, 0, -R),
+  // growing linearly (gradient 1/2) to mesh_size; r [m] the distance from the pole.
+  if (contact_size < mesh_size) {
+    std::ostringstream distance;
+    distance << std::setprecision(17) << "Sqrt(x * x + y * y + (z + " << radius << ") * (z + " << radius << "))";
+    const int from_pole = gmsh::model::mesh::field::add("MathEval");
+    gmsh::model::mesh::field::setString(from_pole, "F", distance.str());
+    const int size = gmsh::model::mesh::field::add("Threshold");
+    gmsh::model::mesh::field::setNumber(size, "InField", from_pole);
+    gmsh::model::mesh::field::setNumber(size, "SizeMin", contact_size);
+    gmsh::model::mesh::field::setNumber(size, "SizeMax", mesh_size);
+    gmsh::model::mesh::field::setNumber(size, "DistMin", refine_radius);
+    gmsh::model::mesh::field::setNumber(size, "DistMax", refine_radius + 2 * (mesh_size - contact_size));
+    gmsh::model::mesh::field::setAsBackgroundMesh(size);
+  }
+  generate_shape_mesh(mesh_size, order);
+
+  const double tol = 1e-6 * radius;
+  SurfaceNamer rules;
+  if (quarter) {
+    rules.push_back({"sym_x", [=](const NodeBox& b) { return b.max.x() < tol; }});
+    rules.push_back({"sym_y", [=](const NodeBox& b) { return b.max.y() < tol; }});
+  }
+  rules.push_back({"flat", [=](const NodeBox& b) { return b.min.z() > -tol; }});
+  rules.push_back({"sphere", [](const NodeBox&) { return true; }});
+  name_regions(rules);
+  return mesh_from_current_gmsh_model(source_of(params, "hemisphere"));
+}
+
+Mesh build_solid_cylinder(const ParamSet& params) {
+  params.allow_only({"type", "mesh_size", "order", "radius", "length", "inner_radius"});
+  const double mesh_size = params.number_in("mesh_size", 1e-12, kHuge);
+  const int order = params.integer_in("order", 1, 2, 1);
+  const double radius = params.number_in("radius", 1e-12, kHuge);
+  const double length = params.number_in("length", 1e-12, kHuge);
+  const double inner_radius = params.number_in("inner_radius", 0.0, radius * (1 - 1e-6), 0.0);
+
+  ScopedShapeModel model("morphfem_solid_cylinder");
+  namespace occ = gmsh::model::occ;
+  const int outer = occ::addCylinder(0, 0, 0, 0, length, 0, radius);
+  if (inner_radius > 0) {
+    // The bore sticks out at both ends so the cut leaves no coincident faces.
+    gmsh::vectorpair tube;
+    std::vector<gmsh::vectorpair> unused_map;
+    occ::cut({{3, outer}}, {{3, occ::addCylinder(0, -length, 0, 0, 3 * length, 0, inner_radius)}}, tube, unused_map);
+  }
+  occ::synchronize();
+  generate_shape_mesh(mesh_size, order);
+
+  const double tol = 1e-6 * std::max(radius, length), r_mid = 0.5 * (radius + inner_radius);
+  SurfaceNamer rules{{"ymin", [=](const NodeBox& b) { return b.max.y() < tol; }},
+                     {"ymax", [=](const NodeBox& b) { return b.min.y() > length - tol; }}};
+  if (inner_radius > 0)
+    rules.push_back({"inner", [=](const NodeBox& b) { return std::max(b.max.x(), b.max.z()) < r_mid; }});
+  rules.push_back({"outer", [](const NodeBox&) { return true; }});
+  name_regions(rules);
+  return mesh_from_current_gmsh_model(source_of(params, "solid_cylinder"));
+}
+
+}  // namespace morphfem
