@@ -117,7 +117,6 @@ struct Reader {
 
 Scene read_scene(const std::string& path) {
   if (!std::filesystem::exists(path)) throw InputError(path, "scene file not found");
-  Reader r{path};
   YAML::Node root;
   try {
     root = YAML::LoadFile(path);
@@ -125,6 +124,11 @@ Scene read_scene(const std::string& path) {
     throw InputError(path + ":" + std::to_string(e.mark.line + 1) + ":" + std::to_string(e.mark.column + 1),
                      "YAML syntax error: " + e.msg);
   }
+  return scene_from_yaml(root, path);
+}
+
+Scene scene_from_yaml(const YAML::Node& root, const std::string& path) {
+  Reader r{path};
   if (!root.IsMap()) throw InputError(path, "a scene must be a mapping with keys geometry/mesh, materials, ...");
   r.allow(root, "",
           {"name", "geometry", "mesh", "materials", "boundary", "loads", "solver", "output", "dynamics", "contact",
@@ -416,10 +420,17 @@ Scene read_scene(const std::string& path) {
     r.allow(a, key,
             {"schedule", "start", "bladders", "growth", "timing", "core", "core_ramp_s", "volume_axes", "feet"});
     if (!a["schedule"]) r.fail(a, key, "missing key 'schedule' (a schedule file)");
-    std::filesystem::path file = r.text(a["schedule"], key + ".schedule");
-    if (file.is_relative()) file = std::filesystem::path(path).parent_path() / file;
-    scene.schedule_file = file.string();
-    schedule = read_schedule(scene.schedule_file);  // its own errors name its file and line
+    if (a["schedule"].IsMap()) {  // the schedule written inline, in the schedule file format
+      YAML::Emitter text;
+      text << a["schedule"];
+      scene.schedule_file = r.at(a["schedule"]);
+      schedule = parse_schedule(text.c_str(), scene.schedule_file + " (actuation.schedule)");
+    } else {
+      std::filesystem::path file = r.text(a["schedule"], key + ".schedule");
+      if (file.is_relative()) file = std::filesystem::path(path).parent_path() / file;
+      scene.schedule_file = file.string();
+      schedule = read_schedule(scene.schedule_file);  // its own errors name its file and line
+    }
     const double start = a["start"] ? r.number(a["start"], key + ".start") : 0.0;
     if (start < 0) r.fail(a["start"], key + ".start", "must be >= 0");
     if (a["growth"] && a["bladders"]) r.fail(a["growth"], key + ".growth", "give either bladders or growth, not both");

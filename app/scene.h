@@ -46,6 +46,7 @@
 //      bladders: {b1: bladder_1_wall, ...},               # channel -> cavity wall surface
 //      core: core_wall, volume_axes: [x, y, z],
 //      feet: {foot_a: foot_a, foot_b: foot_b, mu_active: 2.0, mu_inactive: 1.0e-4}}
+//     # schedule: a file, or the schedule itself inline (a mapping in the schedule file format)
 //     # or, instead of bladder cavities, the voxel study's growth actuation
 //     # (actuation/voxel_growth.h): channel -> bladder volume region, voxel timing
 //     {schedule: ..., start: 1.5, growth: {b1: bladder_1, ...}, core: core_wall,
@@ -60,6 +61,8 @@
 //     # node position along the heading from `start` to the end of the gait, in BL/s.
 //   output: {directory: results/demo, every: 1}
 #pragma once
+#include <yaml-cpp/yaml.h>
+
 #include <array>
 #include <functional>
 #include <map>
@@ -145,5 +148,8 @@ struct Scene {
 // Reads and checks a scene file. Throws InputError("file:line:col", what) on the
 // first problem; nothing is created on disk.
 Scene read_scene(const std::string& path);
+// The same from a parsed document (e.g. a template with keys overridden in code);
+// `path` names it in messages and anchors relative file names.
+Scene scene_from_yaml(const YAML::Node& root, const std::string& path);
 
 }  // namespace morphfem

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <limits>
 #include <stdexcept>
@@ -105,6 +106,15 @@ void require_surface(const Scene& scene, const Mesh& mesh, const std::string& na
 }
 
 }  // namespace
+
+// trajectory.png beside trajectory.csv (scripts/plot_trajectory.py; skipped without python3).
+static void plot_trajectory(const std::string& dir) {
+  const std::string script = std::string(MORPHFEM_SOURCE_DIR) + "/scripts/plot_trajectory.py";
+  if (!std::filesystem::exists("/usr/bin/python3") || !std::filesystem::exists(script)) return;
+  const std::string cmd = "/usr/bin/python3 '" + script + "' '" + dir + "' >&2";
+  if (std::system(cmd.c_str()) != 0)
+    std::fprintf(stderr, "morphfem: plotting the trajectory failed (%s)\n", dir.c_str());
+}
 
 Mesh build_scene_mesh(const Scene& scene, MPI_Comm comm) {
   Mesh mesh = build_on_root(scene, comm);
@@ -480,7 +490,9 @@ SimulationResult run_scene(const Scene& scene, MPI_Comm comm, const RunOptions& 
             .add("gait_time_s", scene.gait.nominal_s)
             .add("simulated_gait_s", scene.gait.end - scene.gait.start)
             .add("gait_start_s", scene.gait.start)
-            .add("body_length_m", body_length);
+            .add("body_length_m", body_length)
+            .add("heading",
+                 std::vector<double>{scene.gait.heading.x(), scene.gait.heading.y(), scene.gait.heading.z()});
         std::string csv = "time_s,centroid_x_m,centroid_y_m,centroid_z_m\n";
         char line[160];
         for (const auto& p : result.trajectory) {
@@ -492,6 +504,7 @@ SimulationResult run_scene(const Scene& scene, MPI_Comm comm, const RunOptions& 
       write_file_atomic(tmp_dir + "/summary.json", summary.str(true) + "\n");
       commit_output_dir(tmp_dir, scene.output_dir);
       result.output_dir = scene.output_dir;
+      if (scene.gait.enabled) plot_trajectory(result.output_dir);
     }
     bcast_string(result.output_dir, comm);
   }

@@ -1,0 +1,348 @@
+#include "app/robot_study.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <sstream>
+
+#include "actuation/voxel_growth.h"
+#include "app/scene.h"
+#include "core/errors.h"
+#include "core/json.h"
+#include "core/progress.h"
+#include "optim/fitness.h"
+
+namespace morphfem {
+
+namespace {
+
+constexpr double kSettleStart = 1.5;  // gait start [s]: core ramp 0.5 s + 1 s of settling
+constexpr double kCoreRamp = 0.5;     // [s]
+
+std::string source_dir() { return MORPHFEM_SOURCE_DIR; }
+
+const char* kRobotUsage =
+    "usage: morphfem robot COMMAND [options]\n"
+    "  validate [--fidelity L] [--cases A,B,...] [--out DIR]\n"
+    "        the voxel study's baselines (hand-designed rolling and inching, flat and\n"
+    "        15 deg hill, four empty schedules): voxel speed beside the finite-element\n"
+    "        speed (voxel-study preset, growth actuation), wall time, dofs, steps\n"
+    "  ladder --case NAME [--levels 0,1,2] [--out DIR]\n"
+    "        one case on several fidelity levels: speed against wall time, and the\n"
+    "        cheapest level within 5 % of the finest\n"
+    "  levels    the fidelity levels\n"
+    "Cases are spread over the MPI ranks (one rank per case): mpirun -n 2 morphfem robot validate\n";
+
+}  // namespace
+
+const std::vector<RobotFidelity>& robot_fidelity_levels() {
+  // Mesh size against the 1 cm skin layers and 4 mm deflated bladders; the time
+  // step against the 0.81 s growth swing and the 0.42 s settle phase.
+  static const std::vector<RobotFidelity> levels = {
+      {"0", 0.02, 1, 0.1},
+      {"1", 0.015, 1, 0.05},
+      {"2", 0.01, 1, 0.025},
+      {"3", 0.0075, 1, 0.0125},
+  };
+  return levels;
+}
+
+const RobotFidelity& find_robot_fidelity(const std::string& name) {
+  std::string known;
+  for (const auto& level : robot_fidelity_levels()) {
+    if (level.name == name) return level;
+    known += (known.empty() ? "" : ", ") + level.name;
+  }
+  throw InputError("--fidelity", "unknown robot fidelity level '" + name + "' (known: " + known + ")");
+}
+
+Schedule voxel_study_schedule(Schedule schedule) {
+  const VoxelActuation voxel;
+  // One lattice column: actuation phase (swing + 1 step) and settle phase.
+  schedule.column_s = (voxel.swing_steps() + 1 + voxel.settle_steps) * voxel.step_s;
+  schedule.repeats = 2;
+  return schedule;
+}
+
+std::vector<RobotCase> voxel_baseline_cases(const std::string& dir) {
+  const std::string templates = dir + "/examples/voxel/";
+  const Schedule rolling = voxel_study_schedule(read_schedule(dir + "/examples/schedules/rolling.yaml"));
+  const Schedule inching = voxel_study_schedule(read_schedule(dir + "/examples/schedules/inching.yaml"));
+  auto empty = [](double orientation_deg, double core_pa) {
+    ScheduleMatrix zeros(kNumRows, std::vector<int>(8, 0));
+    Schedule s = voxel_study_schedule(Schedule::from_matrix(zeros, 1.237, 2, orientation_deg, core_pa));
+    s.name = "empty";
+    return s;
+  };
+  // Voxel speeds [BL/s]: ../shared/data/voxel-study/baselines.txt.
+  return {
+      {"roll_flat", templates + "roll_flat.yaml", rolling, 0, 0.1753136075598921},
+      {"roll_hill15", templates + "roll_flat.yaml", rolling, 15, -0.5743081470776075},
+      {"inch_flat", templates + "inch_flat.yaml", inching, 0, 0.06028166544377857},
+      {"inch_hill15", templates + "inch_flat.yaml", inching, 15, 0.02455621751610403},
+      {"empty_0deg_12kPa_flat", templates + "roll_flat.yaml", empty(0, 12000), 0, 0.000397400321504831},
+      {"empty_90deg_12kPa_hill15", templates + "roll_flat.yaml", empty(90, 12000), 15, -0.026987374336082153},
+      {"empty_0deg_0kPa_flat", templates + "inch_flat.yaml", empty(0, 0), 0, -9.115073925004267e-5},
+      {"empty_90deg_0kPa_hill15", templates + "inch_flat.yaml", empty(90, 0), 15, -6.513284248646143e-5},
+  };
+}
+
+YAML::Node robot_scene_yaml(const RobotCase& c, const RobotFidelity& level, const std::string& output_dir) {
+  if (!std::filesystem::exists(c.template_scene)) throw InputError(c.template_scene, "template scene not found");
+  YAML::Node root = YAML::LoadFile(c.template_scene);
+  YAML::Node a = root["actuation"];
+  if (!a || !a.IsMap() || !a["growth"])
+    throw InputError(c.template_scene, "a robot template needs 'actuation' with 'growth' (the voxel-study preset)");
+  root["name"] = c.name;
+  a["schedule"] = YAML::Load(c.schedule.to_yaml());
+  a["start"] = kSettleStart;
+  a["core_ramp_s"] = kCoreRamp;
+  root["environment"]["slope_deg"] = c.slope_deg;
+  root["environment"]["heading_deg"] = c.schedule.orientation_deg;
+  root["geometry"]["mesh_size"] = level.mesh_size;
+  root["geometry"]["order"] = level.order;
+  const double gait_s = voxel_timeline(c.schedule).duration();
+  root["solver"]["end_time"] = kSettleStart + gait_s + 1e-6;
+  root["solver"]["max_step"] = level.max_step;
+  if (output_dir.empty())
+    root.remove("output");
+  else
+    root["output"]["directory"] = output_dir;
+  return root;
+}
+
+SimulationResult run_robot_case(const RobotCase& c, const RobotFidelity& level, const std::string& output_dir,
+                                MPI_Comm comm, bool progress) {
+  const YAML::Node doc = robot_scene_yaml(c, level, output_dir);
+  // Messages name the template; relative paths in it stay relative to it.
+  Scene scene = scene_from_yaml(doc, c.template_scene);
+  SimulationResult r = run_scene(scene, comm, RunOptions{!output_dir.empty(), progress, {}});
+  int rank = 0;
+  MPI_Comm_rank(comm, &rank);
+  if (rank == 0 && !r.output_dir.empty()) {
+    YAML::Emitter out;
+    out << doc;
+    write_file_atomic(r.output_dir + "/scene.yaml", "# morphfem robot case '" + c.name + "', fidelity " + level.name +
+                                                        " (template " + c.template_scene +
+                                                        "); run it with morphfem run\n" + out.c_str() + "\n");
+  }
+  return r;
+}
+
+double robot_speed(const Genome& genome, double slope_deg, const std::string& fidelity, MPI_Comm comm) {
+  RobotCase c;
+  c.name = "genome";
+  c.template_scene = source_dir() + "/examples/voxel/inch_flat.yaml";
+  c.schedule = voxel_study_schedule(Schedule::from_genome(genome));
+  c.slope_deg = slope_deg;
+  const SimulationResult r = run_robot_case(c, find_robot_fidelity(fidelity), "", comm, false);
+  if (!r.stats.completed || !r.gait_complete) return -std::numeric_limits<double>::infinity();
+  return r.speed_bl_per_s;
+}
+
+void register_robot_fitness() {
+  register_fitness(
+      "robot",
+      [](const Genome& g, const Environment& env, const std::string& fidelity, MPI_Comm comm) {
+        return robot_speed(g, env.slope_deg, fidelity, comm);
+      },
+      "finite-element robot, voxel-study preset with growth actuation (levels: morphfem robot levels)");
+}
+
+namespace {
+
+struct CaseOutcome {
+  double speed = 0, displacement = 0, wall_s = 0, dofs = 0, steps = 0, newton = 0, completed = 0;
+  static constexpr int kFields = 7;
+};
+
+// Runs jobs (case, level) round-robin over the ranks of `comm`, one rank per job;
+// every rank returns every outcome (in job order).
+std::vector<CaseOutcome> run_jobs(const std::vector<std::pair<RobotCase, RobotFidelity>>& jobs,
+                                  const std::string& out_dir, MPI_Comm comm) {
+  int rank = 0, size = 1;
+  MPI_Comm_rank(comm, &rank);
+  MPI_Comm_size(comm, &size);
+  const int n = static_cast<int>(jobs.size());
+  std::vector<double> mine(static_cast<size_t>(n) * CaseOutcome::kFields, 0.0), all(mine.size(), 0.0);
+  Progress progress("robot", n, rank == 0);
+  int done_here = 0;
+  for (int j = rank; j < n; j += size) {
+    const auto& [c, level] = jobs[j];
+    const std::string dir = out_dir.empty() ? "" : out_dir + "/" + c.name + "_L" + level.name;
+    const SimulationResult r = run_robot_case(c, level, dir, PETSC_COMM_SELF, false);
+    const double values[CaseOutcome::kFields] = {r.speed_bl_per_s,
+                                                 r.gait_displacement_m,
+                                                 r.stats.wall_s,
+                                                 static_cast<double>(r.dofs),
+                                                 static_cast<double>(r.stats.steps),
+                                                 static_cast<double>(r.stats.newton_its),
+                                                 r.stats.completed && r.gait_complete ? 1.0 : 0.0};
+    std::copy(values, values + CaseOutcome::kFields, mine.begin() + static_cast<long>(j) * CaseOutcome::kFields);
+    ++done_here;
+    progress.update(std::min<double>(n, done_here * size), c.name + " L" + level.name);
+  }
+  progress.finish();
+  MPI_Allreduce(mine.data(), all.data(), static_cast<int>(all.size()), MPI_DOUBLE, MPI_SUM, comm);
+  std::vector<CaseOutcome> out(n);
+  for (int j = 0; j < n; ++j) {
+    const double* v = all.data() + static_cast<long>(j) * CaseOutcome::kFields;
+    out[j] = {v[0], v[1], v[2], v[3], v[4], v[5], v[6]};
+  }
+  return out;
+}
+
+std::string option(const std::vector<std::string>& args, const std::string& name, const std::string& fallback) {
+  for (size_t i = 0; i + 1 < args.size(); ++i)
+    if (args[i] == name) return args[i + 1];
+  return fallback;
+}
+
+std::vector<std::string> split(const std::string& list) {
+  std::vector<std::string> out;
+  std::stringstream s(list);
+  for (std::string item; std::getline(s, item, ',');)
+    if (!item.empty()) out.push_back(item);
+  return out;
+}
+
+void check_options(const std::vector<std::string>& args, const std::vector<std::string>& allowed) {
+  for (size_t i = 1; i < args.size(); i += 2) {
+    if (std::find(allowed.begin(), allowed.end(), args[i]) == allowed.end())
+      throw InputError("morphfem robot " + args[0], "unknown option '" + args[i] + "'\n" + kRobotUsage);
+    if (i + 1 >= args.size()) throw InputError("morphfem robot " + args[0], "option " + args[i] + " needs a value");
+  }
+}
+
+const RobotCase& find_case(const std::vector<RobotCase>& cases, const std::string& name) {
+  std::string known;
+  for (const auto& c : cases) {
+    if (c.name == name) return c;
+    known += (known.empty() ? "" : ", ") + c.name;
+  }
+  throw InputError("--case", "unknown robot case '" + name + "' (known: " + known + ")");
+}
+
+Json outcome_json(const RobotCase& c, const RobotFidelity& level, const CaseOutcome& o) {
+  Json j;
+  j.add("case", c.name)
+      .add("fidelity", level.name)
+      .add("mesh_size_m", level.mesh_size)
+      .add("order", level.order)
+      .add("max_step_s", level.max_step)
+      .add("slope_deg", c.slope_deg)
+      .add("orientation_deg", c.schedule.orientation_deg)
+      .add("core_pressure_pa", c.schedule.core_pressure_pa)
+      .add("voxel_bl_per_s", c.voxel_bl_per_s)
+      .add("speed_bl_per_s", o.speed)
+      .add("displacement_m", o.displacement)
+      .add("wall_s", o.wall_s)
+      .add("dofs", o.dofs)
+      .add("steps", o.steps)
+      .add("newton_its", o.newton)
+      .add("completed", o.completed > 0);
+  return j;
+}
+
+int validate(const std::vector<std::string>& args, MPI_Comm comm) {
+  check_options(args, {"--fidelity", "--cases", "--out"});
+  const RobotFidelity& level = find_robot_fidelity(option(args, "--fidelity", "0"));
+  const std::string out_dir = option(args, "--out", "results/robot/validate");
+  const auto all_cases = voxel_baseline_cases(source_dir());
+  std::vector<std::pair<RobotCase, RobotFidelity>> jobs;
+  const std::string wanted = option(args, "--cases", "");
+  if (wanted.empty())
+    for (const auto& c : all_cases) jobs.emplace_back(c, level);
+  else
+    for (const auto& name : split(wanted)) jobs.emplace_back(find_case(all_cases, name), level);
+  const auto outcomes = run_jobs(jobs, out_dir, comm);
+  int rank = 0;
+  MPI_Comm_rank(comm, &rank);
+  if (rank != 0) return 0;
+  std::string table =
+      "case                       slope  orient  core_Pa   voxel_BL/s      fem_BL/s   wall_s   dofs  "
+      "steps  newton  status\n";
+  std::vector<Json> rows;
+  char line[256];
+  for (size_t j = 0; j < jobs.size(); ++j) {
+    const auto& c = jobs[j].first;
+    const auto& o = outcomes[j];
+    std::snprintf(line, sizeof line, "%-26s %5.1f  %6.1f  %7.0f  %+11.5f  %+11.5f  %7.1f  %5.0f  %5.0f  %6.0f  %s\n",
+                  c.name.c_str(), c.slope_deg, c.schedule.orientation_deg, c.schedule.core_pressure_pa,
+                  c.voxel_bl_per_s, o.speed, o.wall_s, o.dofs, o.steps, o.newton, o.completed > 0 ? "ok" : "FAILED");
+    table += line;
+    rows.push_back(outcome_json(c, level, o));
+  }
+  std::printf("fidelity %s: mesh %.4g m, P%d, max step %.4g s\n%s", level.name.c_str(), level.mesh_size, level.order,
+              level.max_step, table.c_str());
+  std::filesystem::create_directories(out_dir);
+  Json summary;
+  summary.add("fidelity", level.name).add("cases", rows);
+  write_file_atomic(out_dir + "/validation.json", summary.str(true) + "\n");
+  write_file_atomic(out_dir + "/validation.txt", table);
+  std::printf("results: %s/validation.json, per case %s/CASE_L%s/\n", out_dir.c_str(), out_dir.c_str(),
+              level.name.c_str());
+  return 0;
+}
+
+int ladder(const std::vector<std::string>& args, MPI_Comm comm) {
+  check_options(args, {"--case", "--levels", "--out"});
+  const std::string name = option(args, "--case", "");
+  if (name.empty()) throw InputError("morphfem robot ladder", "needs --case NAME");
+  const auto all_cases = voxel_baseline_cases(source_dir());
+  const RobotCase& c = find_case(all_cases, name);
+  const std::string out_dir = option(args, "--out", "results/robot/ladder");
+  std::vector<std::pair<RobotCase, RobotFidelity>> jobs;
+  for (const auto& l : split(option(args, "--levels", "0,1,2"))) jobs.emplace_back(c, find_robot_fidelity(l));
+  const auto outcomes = run_jobs(jobs, out_dir, comm);
+  int rank = 0;
+  MPI_Comm_rank(comm, &rank);
+  if (rank != 0) return 0;
+  const double finest = outcomes.back().speed;
+  std::string table = "case          level  mesh_m   P  max_step_s   fem_BL/s   vs_finest   wall_s   dofs  steps\n";
+  std::string pick = "none";
+  std::vector<Json> rows;
+  char line[256];
+  for (size_t j = 0; j < jobs.size(); ++j) {
+    const auto& l = jobs[j].second;
+    const auto& o = outcomes[j];
+    const double rel = std::abs(o.speed - finest) / std::max(std::abs(finest), 1e-12);
+    if (pick == "none" && o.completed > 0 && rel <= 0.05) pick = l.name;
+    std::snprintf(line, sizeof line, "%-13s %5s  %6.4f  %d  %10.4g  %+10.5f  %9.2e  %7.1f  %5.0f  %5.0f%s\n",
+                  c.name.c_str(), l.name.c_str(), l.mesh_size, l.order, l.max_step, o.speed, rel, o.wall_s, o.dofs,
+                  o.steps, o.completed > 0 ? "" : "  FAILED");
+    table += line;
+    rows.push_back(outcome_json(c, l, o));
+  }
+  std::printf("%scheapest level within 5 %% of the finest (%s): %s\n", table.c_str(), jobs.back().second.name.c_str(),
+              pick.c_str());
+  std::filesystem::create_directories(out_dir);
+  Json summary;
+  summary.add("case", c.name).add("within_5_percent_of_finest", pick).add("levels", rows);
+  write_file_atomic(out_dir + "/" + c.name + "_ladder.json", summary.str(true) + "\n");
+  return 0;
+}
+
+}  // namespace
+
+int robot_main(const std::vector<std::string>& args, MPI_Comm comm) {
+  if (args.empty() || args[0] == "--help" || args[0] == "-h") {
+    std::fputs(kRobotUsage, stdout);
+    return args.empty() ? 2 : 0;
+  }
+  if (args[0] == "validate") return validate(args, comm);
+  if (args[0] == "ladder") return ladder(args, comm);
+  if (args[0] == "levels") {
+    for (const auto& l : robot_fidelity_levels())
+      std::printf("level %s: mesh_size %.4g m, P%d, max_step %.4g s\n", l.name.c_str(), l.mesh_size, l.order,
+                  l.max_step);
+    return 0;
+  }
+  throw InputError("morphfem robot", "unknown command '" + args[0] + "'\n" + kRobotUsage);
+}
+
+}  // namespace morphfem

@@ -1,0 +1,79 @@
+// The robot as a study (issue 5): gait scenes built from a template scene with the
+// schedule, the slope and the fidelity level set in code, the validation of the
+// voxel study's baselines (../shared/data/voxel-study/baselines.txt), fidelity
+// ladders, and the "robot" fitness of the search (optim/fitness.h).
+//
+// A robot case = template scene (examples/voxel/*.yaml: geometry, materials,
+// contact, friction regions, dynamics) + schedule (written inline into the scene)
+// + slope + fidelity level. What the case sets in the template:
+//   actuation.schedule   the case's schedule (inline), column_s = the lattice's
+//                        column (11670 steps of 1.0602e-4 s = 1.23731 s), 2 repeats;
+//   actuation.start      1.5 s: the core ramps to its pressure over 0.5 s, then the
+//                        robot settles for 1 s (gravity, contact) before column 1;
+//   environment          slope_deg; the heading is the schedule's orientation;
+//   solver.end_time      start + the gait's duration on the voxel timing;
+//   geometry.mesh_size, geometry.order, solver.max_step   from the fidelity level;
+//   output.directory     the case's result folder (or none).
+// The speed is the scene's gait measurement: displacement of the mean node
+// position along the heading from start to the end of the gait, divided by the
+// body length (0.22 m) and the schedule's nominal duration (16 columns), as the
+// voxel study's BL/s.
+#pragma once
+#include <mpi.h>
+
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "actuation/schedule.h"
+#include "app/simulation.h"
+
+namespace morphfem {
+
+// A fidelity level of the robot scenes (mesh, element order, largest time step).
+struct RobotFidelity {
+  std::string name;
+  double mesh_size = 0.015;  // [m]
+  int order = 1;
+  double max_step = 0.05;  // [s]
+};
+// Levels "0" (coarsest, the search level) .. "3" (finest).
+const std::vector<RobotFidelity>& robot_fidelity_levels();
+// Throws InputError naming the known levels.
+const RobotFidelity& find_robot_fidelity(const std::string& name);
+
+struct RobotCase {
+  std::string name;            // e.g. "inch_flat"
+  std::string template_scene;  // path of the template scene
+  Schedule schedule;
+  double slope_deg = 0;
+  double voxel_bl_per_s = std::numeric_limits<double>::quiet_NaN();  // the voxel study's result, if any
+};
+
+// The eight cases of baselines.txt: the hand-designed rolling (0 deg, 12 kPa) and
+// inching (90 deg, 0 kPa) gaits on flat ground and on the 15 deg hill, and the four
+// empty schedules. `source_dir` is the repository (templates in examples/voxel/).
+std::vector<RobotCase> voxel_baseline_cases(const std::string& source_dir);
+
+// The schedule of a case as the lattice plays it: the voxel study's column length,
+// two repeats.
+Schedule voxel_study_schedule(Schedule schedule);
+
+// The case's scene document: the template with the keys above set.
+YAML::Node robot_scene_yaml(const RobotCase& c, const RobotFidelity& level, const std::string& output_dir);
+
+// Builds and runs the case (no files unless output_dir is given; then the scene
+// document is saved beside the results as scene.yaml).
+SimulationResult run_robot_case(const RobotCase& c, const RobotFidelity& level, const std::string& output_dir,
+                                MPI_Comm comm, bool progress);
+
+// The search fitness "robot": speed [BL/s] of `genome` on the voxel-study preset
+// (template examples/voxel/inch_flat.yaml) at fidelity level `fidelity`.
+double robot_speed(const Genome& genome, double slope_deg, const std::string& fidelity, MPI_Comm comm);
+// Registers "robot" with optim/fitness.h (called by the program before a search).
+void register_robot_fitness();
+
+// `morphfem robot validate|ladder ...` (usage in robot_study.cpp).
+int robot_main(const std::vector<std::string>& args, MPI_Comm comm);
+
+}  // namespace morphfem
