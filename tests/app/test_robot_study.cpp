@@ -1,0 +1,87 @@
+// Robot cases (app/robot_study.h): the template keys a case sets, the baseline
+// cases of the voxel study, inline schedules, and one cheap run that must not drift.
+#include <gtest/gtest.h>
+#include <petscsys.h>
+
+#include <cmath>
+
+#include "actuation/voxel_growth.h"
+#include "app/robot_study.h"
+#include "app/scene.h"
+#include "core/errors.h"
+
+using namespace morphfem;
+
+namespace {
+
+const RobotCase& baseline(const std::string& name) {
+  static const auto cases = voxel_baseline_cases(MORPHFEM_SOURCE_DIR);
+  for (const auto& c : cases)
+    if (c.name == name) return c;
+  throw std::runtime_error("no case " + name);
+}
+
+}  // namespace
+
+TEST(RobotStudy, BaselineCasesAreTheVoxelStudys) {
+  const auto cases = voxel_baseline_cases(MORPHFEM_SOURCE_DIR);
+  ASSERT_EQ(cases.size(), 8u);
+  EXPECT_NEAR(baseline("roll_flat").voxel_bl_per_s, 0.1753136, 1e-6);
+  EXPECT_NEAR(baseline("inch_hill15").voxel_bl_per_s, 0.0245562, 1e-6);
+  EXPECT_EQ(baseline("roll_hill15").slope_deg, 15);
+  EXPECT_EQ(baseline("roll_flat").schedule.orientation_deg, 0);
+  EXPECT_EQ(baseline("roll_flat").schedule.core_pressure_pa, 12000);
+  EXPECT_EQ(baseline("inch_flat").schedule.orientation_deg, 90);
+  EXPECT_EQ(baseline("inch_flat").schedule.core_pressure_pa, 0);
+  // The lattice's column: 7667 swing steps + 1 + 4001 settle steps of dt.
+  const VoxelActuation voxel;
+  EXPECT_NEAR(baseline("inch_flat").schedule.column_s, 11669 * voxel.step_s, 1e-12);
+  EXPECT_EQ(baseline("inch_flat").schedule.repeats, 2);
+  // Empty schedules: nothing inflates, the feet never switch on.
+  for (int row = 0; row < kNumRows; ++row)
+    for (int k = 0; k < 8; ++k) EXPECT_FALSE(baseline("empty_90deg_0kPa_hill15").schedule.active(row, k));
+}
+
+TEST(RobotStudy, CaseSetsScheduleSlopeHeadingAndFidelityInTheTemplate) {
+  const RobotCase& c = baseline("inch_hill15");
+  const RobotFidelity& level = find_robot_fidelity("0");
+  const YAML::Node doc = robot_scene_yaml(c, level, "");
+  EXPECT_FALSE(doc["output"]);
+  EXPECT_EQ(doc["geometry"]["mesh_size"].as<double>(), level.mesh_size);
+  Scene scene = scene_from_yaml(doc, c.template_scene);
+  EXPECT_TRUE(scene.output_dir.empty());
+  ASSERT_TRUE(scene.gait.enabled);
+  // Heading 90 deg: along +y; the study's rotated gravity g(0, -sin 15, -cos 15).
+  EXPECT_NEAR(scene.gait.heading.y(), 1.0, 1e-12);
+  const double s = std::sin(15 * M_PI / 180);
+  EXPECT_NEAR(scene.gravity.y(), -9.80665 * s, 1e-9);
+  EXPECT_NEAR(scene.gravity.x(), 0.0, 1e-9);
+  EXPECT_NEAR(scene.gait.end - scene.gait.start, voxel_timeline(c.schedule).duration(), 1e-12);
+  EXPECT_LE(scene.gait.end, scene.solver.t_end);
+  EXPECT_NEAR(scene.gait.nominal_s, 16 * c.schedule.column_s, 1e-8);  // the inline schedule keeps 10 digits
+  EXPECT_EQ(scene.growth.size(), 8u);
+  EXPECT_THROW(find_robot_fidelity("9"), InputError);
+}
+
+TEST(RobotStudy, BadInlineScheduleNamesTheScene) {
+  YAML::Node doc = robot_scene_yaml(baseline("inch_flat"), find_robot_fidelity("0"), "");
+  doc["actuation"]["schedule"]["matrix"][3] = "10102010";
+  try {
+    scene_from_yaml(doc, "template.yaml");
+    FAIL() << "a matrix entry of 2 must be refused";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("template.yaml"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("matrix"), std::string::npos) << e.what();
+  }
+}
+
+// Without actuation the robot must stay where it settled: the voxel study's empty
+// schedule on flat ground moved -9e-5 BL/s; the bound is 0.005 BL/s.
+TEST(RobotStudy, EmptyScheduleOnFlatGroundStaysPut) {
+  const SimulationResult r =
+      run_robot_case(baseline("empty_0deg_0kPa_flat"), find_robot_fidelity("0"), "", PETSC_COMM_WORLD, false);
+  ASSERT_TRUE(r.stats.completed) << r.stats.failure;
+  ASSERT_TRUE(r.gait_complete);
+  EXPECT_LT(std::abs(r.speed_bl_per_s), 0.005);
+  EXPECT_GT(r.min_J, 0.0);
+}
