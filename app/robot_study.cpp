@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <sstream>
 
@@ -34,6 +35,9 @@ const char* kRobotUsage =
     "  ladder --case NAME [--levels 0,1,2] [--out DIR]\n"
     "        one case on several fidelity levels: speed against wall time, and the\n"
     "        cheapest level within 5 % of the finest\n"
+    "  morph [--scene FILE] [--out DIR]\n"
+    "        shape change under core pressure (default examples/voxel/morph.yaml): width /\n"
+    "        thickness of the mid-length cross-section against core pressure, table, CSV, PNG\n"
     "  levels    the fidelity levels\n"
     "Cases are spread over the MPI ranks (one rank per case): mpirun -n 2 morphfem robot validate\n";
 
@@ -327,6 +331,76 @@ int ladder(const std::vector<std::string>& args, MPI_Comm comm) {
   return 0;
 }
 
+// Extents of the deformed mid-length cross-section [m]: x (width), y (length of the
+// whole body), z (thickness). The cross-section is the nodes within 10 % of the body
+// length of its middle (reference y), away from the sealed ends that stay flat.
+Eigen::Vector3d extents(const Mesh& mesh, const RowMatrixXd& u) {
+  const double y0 = mesh.X.col(1).minCoeff(), y1 = mesh.X.col(1).maxCoeff(), mid = 0.5 * (y0 + y1);
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = -lo;
+  double ylo = 1e300, yhi = -1e300;
+  for (int n = 0; n < mesh.n_nodes(); ++n) {
+    const Eigen::Vector3d x = mesh.X.row(n).transpose() + u.row(n).transpose();
+    ylo = std::min(ylo, x.y());
+    yhi = std::max(yhi, x.y());
+    if (std::abs(mesh.X(n, 1) - mid) > 0.1 * (y1 - y0)) continue;
+    lo = lo.cwiseMin(x);
+    hi = hi.cwiseMax(x);
+  }
+  return {hi.x() - lo.x(), yhi - ylo, hi.z() - lo.z()};
+}
+
+int morph(const std::vector<std::string>& args, MPI_Comm comm) {
+  check_options(args, {"--scene", "--out"});
+  const std::string path = option(args, "--scene", source_dir() + "/examples/voxel/morph.yaml");
+  Scene scene = read_scene(path);
+  if (scene.cavities.empty()) throw InputError(path, "morph needs a pressurised core (loads.cavities)");
+  const std::string out_dir =
+      option(args, "--out", scene.output_dir.empty() ? "results/robot/morph" : scene.output_dir);
+  scene.output_dir = out_dir;
+  struct Sample {
+    double t, p, width, length, thickness;
+  };
+  std::vector<Sample> samples;
+  RunOptions options;
+  options.on_step = [&](double t, const Mesh& mesh, const RowMatrixXd& u, const SimulationResult& r) {
+    const Eigen::Vector3d e = extents(mesh, u);
+    samples.push_back({t, r.cavity_pressure.at(0), e.x(), e.y(), e.z()});
+  };
+  const SimulationResult r = run_scene(scene, comm, options);
+  int rank = 0;
+  MPI_Comm_rank(comm, &rank);
+  if (rank != 0) return r.stats.completed ? 0 : 3;
+  std::string csv = "time_s,core_pressure_pa,width_m,length_m,thickness_m,width_over_thickness\n";
+  std::string table = "    t [s]  core [Pa]  width [cm]  thickness [cm]  width/thickness\n";
+  char line[200];
+  double last_p = -1;
+  for (size_t i = 0; i < samples.size(); ++i) {
+    const Sample& s = samples[i];
+    std::snprintf(line, sizeof line, "%.6g,%.6g,%.6g,%.6g,%.6g,%.6g\n", s.t, s.p, s.width, s.length, s.thickness,
+                  s.width / s.thickness);
+    csv += line;
+    // The table: the first sample, every 1 kPa change of pressure, the last sample.
+    if (i == 0 || i + 1 == samples.size() || std::abs(s.p - last_p) >= 999.0) {
+      std::snprintf(line, sizeof line, "%9.3f  %9.0f  %10.2f  %14.2f  %15.2f\n", s.t, s.p, 100 * s.width,
+                    100 * s.thickness, s.width / s.thickness);
+      table += line;
+      last_p = s.p;
+    }
+  }
+  std::fputs(table.c_str(), stdout);
+  if (!r.stats.completed) std::printf("run failed: %s\n", r.stats.failure.c_str());
+  if (!r.output_dir.empty()) {
+    write_file_atomic(r.output_dir + "/morph.csv", csv);
+    const std::string script = source_dir() + "/scripts/plot_morph.py";
+    if (std::filesystem::exists("/usr/bin/python3") && std::filesystem::exists(script)) {
+      const std::string cmd = "/usr/bin/python3 '" + script + "' '" + r.output_dir + "/morph.csv' >&2";
+      if (std::system(cmd.c_str()) != 0) std::fprintf(stderr, "morphfem: plotting failed\n");
+    }
+    std::printf("results: %s/morph.csv, %s/morph.png\n", r.output_dir.c_str(), r.output_dir.c_str());
+  }
+  return r.stats.completed ? 0 : 3;
+}
+
 }  // namespace
 
 int robot_main(const std::vector<std::string>& args, MPI_Comm comm) {
@@ -336,6 +410,7 @@ int robot_main(const std::vector<std::string>& args, MPI_Comm comm) {
   }
   if (args[0] == "validate") return validate(args, comm);
   if (args[0] == "ladder") return ladder(args, comm);
+  if (args[0] == "morph") return morph(args, comm);
   if (args[0] == "levels") {
     for (const auto& l : robot_fidelity_levels())
       std::printf("level %s: mesh_size %.4g m, P%d, max_step %.4g s\n", l.name.c_str(), l.mesh_size, l.order,
