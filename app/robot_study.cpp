@@ -3,11 +3,13 @@
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <sstream>
 
 #include "actuation/voxel_growth.h"
@@ -38,6 +40,12 @@ const char* kRobotUsage =
     "  morph [--scene FILE] [--out DIR]\n"
     "        shape change under core pressure (default examples/voxel/morph.yaml): width /\n"
     "        thickness of the mid-length cross-section against core pressure, table, CSV, PNG\n"
+    "  friction-sweep [--fidelity L] [--points all|N] [--out DIR]\n"
+    "        inching on flat ground against the feet's mean friction (the voxel study's\n"
+    "        sfrict_results.csv: active - inactive = 2.0), beside the voxel points, PNG\n"
+    "  benchmark [--fidelity L]\n"
+    "        wall time of each hand-designed gait (19.8 s) on one rank, beside the voxel\n"
+    "        simulator's 136-145 s on this machine\n"
     "  levels    the fidelity levels\n"
     "Cases are spread over the MPI ranks (one rank per case): mpirun -n 2 morphfem robot validate\n";
 
@@ -105,6 +113,8 @@ YAML::Node robot_scene_yaml(const RobotCase& c, const RobotFidelity& level, cons
   a["schedule"] = YAML::Load(c.schedule.to_yaml());
   a["start"] = kSettleStart;
   a["core_ramp_s"] = kCoreRamp;
+  if (!std::isnan(c.mu_foot_active)) a["feet"]["mu_active"] = c.mu_foot_active;
+  if (!std::isnan(c.mu_foot_inactive)) a["feet"]["mu_inactive"] = c.mu_foot_inactive;
   root["environment"]["slope_deg"] = c.slope_deg;
   root["environment"]["heading_deg"] = c.schedule.orientation_deg;
   root["geometry"]["mesh_size"] = level.mesh_size;
@@ -349,6 +359,108 @@ Eigen::Vector3d extents(const Mesh& mesh, const RowMatrixXd& u) {
   return {hi.x() - lo.x(), yhi - ylo, hi.z() - lo.z()};
 }
 
+// The voxel study's friction sweep: rows (low, high, distance, time, BLs).
+std::vector<std::array<double, 3>> read_sfrict(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw InputError(path, "cannot read the voxel study's friction sweep");
+  std::vector<std::array<double, 3>> rows;  // low, high, BL/s
+  std::string line;
+  int number = 0;
+  while (std::getline(in, line)) {
+    ++number;
+    if (number == 1 || line.empty()) continue;  // header
+    std::array<double, 5> v{};
+    std::stringstream s(line);
+    std::string cell;
+    for (int i = 0; i < 5; ++i) {
+      if (!std::getline(s, cell, ',')) throw InputError(path + ":" + std::to_string(number), "expected 5 columns");
+      try {
+        v[i] = std::stod(cell);
+      } catch (const std::exception&) {
+        throw InputError(path + ":" + std::to_string(number), "not a number: '" + cell + "'");
+      }
+    }
+    rows.push_back({v[0], v[1], v[4]});
+  }
+  if (rows.empty()) throw InputError(path, "no data rows");
+  return rows;
+}
+
+int friction_sweep(const std::vector<std::string>& args, MPI_Comm comm) {
+  check_options(args, {"--fidelity", "--points", "--out"});
+  const RobotFidelity& level = find_robot_fidelity(option(args, "--fidelity", "0"));
+  const std::string out_dir = option(args, "--out", "results/robot/friction_sweep");
+  const std::string data = source_dir() + "/../shared/data/voxel-study/sfrict_results.csv";
+  auto rows = read_sfrict(data);
+  const std::string points = option(args, "--points", "6");
+  if (points != "all") {  // every k-th row, first and last included
+    const int n = std::stoi(points);
+    if (n < 2) throw InputError("--points", "needs at least 2 points (or 'all')");
+    std::vector<std::array<double, 3>> picked;
+    for (int i = 0; i < n; ++i)
+      picked.push_back(rows[static_cast<size_t>(std::lround(i * (rows.size() - 1.0) / (n - 1)))]);
+    rows = picked;
+  }
+  RobotCase inch;
+  for (const auto& c : voxel_baseline_cases(source_dir()))
+    if (c.name == "inch_flat") inch = c;
+  std::vector<std::pair<RobotCase, RobotFidelity>> jobs;
+  for (const auto& [low, high, voxel] : rows) {
+    RobotCase c = inch;
+    char name[64];
+    std::snprintf(name, sizeof name, "inch_flat_mu%.2f_%.2f", low, high);
+    c.name = name;
+    c.mu_foot_inactive = std::max(low, 1e-4);  // the study's inactive value at the first point
+    c.mu_foot_active = high;
+    c.voxel_bl_per_s = voxel;
+    jobs.emplace_back(c, level);
+  }
+  const auto outcomes = run_jobs(jobs, out_dir, comm);
+  int rank = 0;
+  MPI_Comm_rank(comm, &rank);
+  if (rank != 0) return 0;
+  std::string table = "  mu_low  mu_high  mean_mu   voxel_BL/s     fem_BL/s   wall_s  status\n";
+  std::vector<Json> out_rows;
+  char line[200];
+  for (size_t j = 0; j < jobs.size(); ++j) {
+    const RobotCase& c = jobs[j].first;
+    const auto& o = outcomes[j];
+    std::snprintf(line, sizeof line, "%8.2f  %7.2f  %7.2f  %+11.5f  %+11.5f  %7.1f  %s\n", rows[j][0], rows[j][1],
+                  0.5 * (rows[j][0] + rows[j][1]), c.voxel_bl_per_s, o.speed, o.wall_s,
+                  o.completed > 0 ? "ok" : "FAILED");
+    table += line;
+    Json r = outcome_json(c, level, o);
+    r.add("mu_low", rows[j][0]).add("mu_high", rows[j][1]);
+    out_rows.push_back(r);
+  }
+  std::printf("inching on flat ground against the feet's mean friction, fidelity %s\n%s", level.name.c_str(),
+              table.c_str());
+  std::filesystem::create_directories(out_dir);
+  Json summary;
+  summary.add("fidelity", level.name).add("points", out_rows);
+  write_file_atomic(out_dir + "/friction_sweep.json", summary.str(true) + "\n");
+  const std::string script = source_dir() + "/scripts/plot_friction_sweep.py";
+  if (std::filesystem::exists("/usr/bin/python3") && std::filesystem::exists(script)) {
+    const std::string cmd =
+        "/usr/bin/python3 '" + script + "' '" + out_dir + "/friction_sweep.json' '" + data + "' >&2";
+    if (std::system(cmd.c_str()) != 0) std::fprintf(stderr, "morphfem: plotting failed\n");
+  }
+  std::printf("results: %s/friction_sweep.json, %s/friction_sweep.png\n", out_dir.c_str(), out_dir.c_str());
+  return 0;
+}
+
+int benchmark(const std::vector<std::string>& args, MPI_Comm comm) {
+  check_options(args, {"--fidelity"});
+  int size = 1;
+  MPI_Comm_size(comm, &size);
+  if (size != 1) throw InputError("morphfem robot benchmark", "times one rank per gait: run it without mpirun");
+  const std::string level = option(args, "--fidelity", "0");
+  std::printf("voxel simulator (Voxelyze, 1428 voxels, 186,719 explicit steps, one thread): 136-145 s per gait\n");
+  return validate({"validate", "--fidelity", level, "--cases", "roll_flat,roll_hill15,inch_flat,inch_hill15", "--out",
+                   "results/robot/benchmark_L" + level},
+                  comm);
+}
+
 int morph(const std::vector<std::string>& args, MPI_Comm comm) {
   check_options(args, {"--scene", "--out"});
   const std::string path = option(args, "--scene", source_dir() + "/examples/voxel/morph.yaml");
@@ -411,6 +523,8 @@ int robot_main(const std::vector<std::string>& args, MPI_Comm comm) {
   if (args[0] == "validate") return validate(args, comm);
   if (args[0] == "ladder") return ladder(args, comm);
   if (args[0] == "morph") return morph(args, comm);
+  if (args[0] == "friction-sweep") return friction_sweep(args, comm);
+  if (args[0] == "benchmark") return benchmark(args, comm);
   if (args[0] == "levels") {
     for (const auto& l : robot_fidelity_levels())
       std::printf("level %s: mesh_size %.4g m, P%d, max_step %.4g s\n", l.name.c_str(), l.mesh_size, l.order,

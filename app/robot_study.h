@@ -48,6 +48,9 @@ struct RobotCase {
   Schedule schedule;
   double slope_deg = 0;
   double voxel_bl_per_s = std::numeric_limits<double>::quiet_NaN();  // the voxel study's result, if any
+  // Foot friction (active / inactive); NaN keeps the template's.
+  double mu_foot_active = std::numeric_limits<double>::quiet_NaN();
+  double mu_foot_inactive = std::numeric_limits<double>::quiet_NaN();
 };
 
 // The eight cases of baselines.txt: the hand-designed rolling (0 deg, 12 kPa) and
