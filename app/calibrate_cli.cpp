@@ -14,6 +14,7 @@
 #include <sstream>
 
 #include "app/drag_scene.h"
+#include "app/plot.h"
 #include "core/errors.h"
 #include "core/json.h"
 #include "core/test_machine_export.h"
@@ -45,12 +46,7 @@ const char* kCalibrateUsage =
 std::string plot_script() { return std::string(MORPHFEM_SOURCE_DIR) + "/scripts/plot_calibration.py"; }
 
 bool run_plot(const std::vector<std::string>& args) {
-  const std::string script = plot_script();
-  if (!std::filesystem::exists("/usr/bin/python3") || !std::filesystem::exists(script)) return false;
-  std::string cmd = "/usr/bin/python3 '" + script + "'";
-  for (const auto& a : args) cmd += " '" + a + "'";
-  cmd += " >&2";
-  return std::system(cmd.c_str()) == 0;
+  return run_plot_script("plot_calibration.py", args, "the calibration");
 }
 
 double number_option(const std::string& command, const std::string& option, const std::string& text, double lo,

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "app/calibrate_cli.h"
+#include "app/plot.h"
 #include "app/robot_study.h"
 #include "app/scene.h"
 #include "app/search_cli.h"
@@ -112,12 +113,7 @@ int cmd_verify(const std::vector<std::string>& args) {
   std::filesystem::create_directories(out_dir);
   const std::string jsonl = out_dir + "/verification.jsonl";
   morphfem::write_file_atomic(jsonl, lines);
-  const std::string script = std::string(MORPHFEM_SOURCE_DIR) + "/scripts/plot_verification.py";
-  if (std::filesystem::exists("/usr/bin/python3") && std::filesystem::exists(script)) {
-    const std::string cmd = "/usr/bin/python3 '" + script + "' '" + jsonl + "' '" + out_dir + "' >&2";
-    if (std::system(cmd.c_str()) != 0)
-      std::fprintf(stderr, "morphfem: plotting failed (results are in %s)\n", jsonl.c_str());
-  }
+  morphfem::run_plot_script("plot_verification.py", {jsonl, out_dir}, "the verification");
   if (!json) std::printf("records: %s; plots: %s/*.png\n", jsonl.c_str(), out_dir.c_str());
   return 0;
 }

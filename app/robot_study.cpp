@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "actuation/voxel_growth.h"
+#include "app/plot.h"
 #include "app/scene.h"
 #include "core/errors.h"
 #include "core/json.h"
@@ -439,12 +440,7 @@ int friction_sweep(const std::vector<std::string>& args, MPI_Comm comm) {
   Json summary;
   summary.add("fidelity", level.name).add("points", out_rows);
   write_file_atomic(out_dir + "/friction_sweep.json", summary.str(true) + "\n");
-  const std::string script = source_dir() + "/scripts/plot_friction_sweep.py";
-  if (std::filesystem::exists("/usr/bin/python3") && std::filesystem::exists(script)) {
-    const std::string cmd =
-        "/usr/bin/python3 '" + script + "' '" + out_dir + "/friction_sweep.json' '" + data + "' >&2";
-    if (std::system(cmd.c_str()) != 0) std::fprintf(stderr, "morphfem: plotting failed\n");
-  }
+  run_plot_script("plot_friction_sweep.py", {out_dir + "/friction_sweep.json", data}, "the friction sweep");
   std::printf("results: %s/friction_sweep.json, %s/friction_sweep.png\n", out_dir.c_str(), out_dir.c_str());
   return 0;
 }
@@ -503,11 +499,7 @@ int morph(const std::vector<std::string>& args, MPI_Comm comm) {
   if (!r.stats.completed) std::printf("run failed: %s\n", r.stats.failure.c_str());
   if (!r.output_dir.empty()) {
     write_file_atomic(r.output_dir + "/morph.csv", csv);
-    const std::string script = source_dir() + "/scripts/plot_morph.py";
-    if (std::filesystem::exists("/usr/bin/python3") && std::filesystem::exists(script)) {
-      const std::string cmd = "/usr/bin/python3 '" + script + "' '" + r.output_dir + "/morph.csv' >&2";
-      if (std::system(cmd.c_str()) != 0) std::fprintf(stderr, "morphfem: plotting failed\n");
-    }
+    run_plot_script("plot_morph.py", {r.output_dir + "/morph.csv"}, "the shape change");
     std::printf("results: %s/morph.csv, %s/morph.png\n", r.output_dir.c_str(), r.output_dir.c_str());
   }
   return r.stats.completed ? 0 : 3;

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <sstream>
 
+#include "app/plot.h"
 #include "core/errors.h"
 #include "core/json.h"
 #include "optim/fitness.h"
@@ -149,14 +150,8 @@ int search_main(const std::vector<std::string>& args, MPI_Comm comm) {
   write_file_atomic(json, summary_json(report, o));
   std::printf("\nresults: %s/<experiment>/<method>/ (CSV, checkpoint.h5, best/*.yaml), %s/summary.{md,json}\n",
               o.out_dir.c_str(), o.out_dir.c_str());
-  const std::string script = std::string(MORPHFEM_SOURCE_DIR) + "/scripts/plot_search.py";
-  if (plot && std::filesystem::exists("/usr/bin/python3") && std::filesystem::exists(script)) {
-    const std::string cmd = "/usr/bin/python3 '" + script + "' '" + json + "' '" + o.out_dir + "' >&2";
-    if (std::system(cmd.c_str()) != 0)
-      std::fprintf(stderr, "morphfem: plotting failed (results are in %s)\n", o.out_dir.c_str());
-    else
-      std::printf("curves: %s/curves*.png\n", o.out_dir.c_str());
-  }
+  if (plot && run_plot_script("plot_search.py", {json, o.out_dir}, "the search curves"))
+    std::printf("curves: %s/curves*.png\n", o.out_dir.c_str());
   return 0;
 }
 

@@ -11,6 +11,7 @@
 #include <stdexcept>
 
 #include "actuation/cavity.h"
+#include "app/plot.h"
 #include "contact/friction.h"
 #include "contact/ground.h"
 #include "contact/self_contact.h"
@@ -106,15 +107,6 @@ void require_surface(const Scene& scene, const Mesh& mesh, const std::string& na
 }
 
 }  // namespace
-
-// trajectory.png beside trajectory.csv (scripts/plot_trajectory.py; skipped without python3).
-static void plot_trajectory(const std::string& dir) {
-  const std::string script = std::string(MORPHFEM_SOURCE_DIR) + "/scripts/plot_trajectory.py";
-  if (!std::filesystem::exists("/usr/bin/python3") || !std::filesystem::exists(script)) return;
-  const std::string cmd = "/usr/bin/python3 '" + script + "' '" + dir + "' >&2";
-  if (std::system(cmd.c_str()) != 0)
-    std::fprintf(stderr, "morphfem: plotting the trajectory failed (%s)\n", dir.c_str());
-}
 
 Mesh build_scene_mesh(const Scene& scene, MPI_Comm comm) {
   Mesh mesh = build_on_root(scene, comm);
@@ -504,7 +496,8 @@ SimulationResult run_scene(const Scene& scene, MPI_Comm comm, const RunOptions& 
       write_file_atomic(tmp_dir + "/summary.json", summary.str(true) + "\n");
       commit_output_dir(tmp_dir, scene.output_dir);
       result.output_dir = scene.output_dir;
-      if (scene.gait.enabled) plot_trajectory(result.output_dir);
+      // trajectory.png beside trajectory.csv
+      if (scene.gait.enabled) run_plot_script("plot_trajectory.py", {result.output_dir}, "the trajectory");
     }
     bcast_string(result.output_dir, comm);
   }

@@ -57,18 +57,6 @@ int divisions(double length, double mesh_size) {
   return std::max(1, static_cast<int>(std::lround(length / mesh_size)));
 }
 
-// A fresh gmsh model for one build, removed when the scope ends (also on errors).
-class ScopedGmshModel {
- public:
-  explicit ScopedGmshModel(const std::string& name) {
-    initialize_gmsh();
-    gmsh::model::add(name);
-  }
-  ~ScopedGmshModel() { gmsh::model::remove(); }
-  ScopedGmshModel(const ScopedGmshModel&) = delete;
-  ScopedGmshModel& operator=(const ScopedGmshModel&) = delete;
-};
-
 // Meshes the synchronized model in 3-D with target size h and the element order;
 // second-order nodes are placed on the curved geometry.
 void generate_mesh(const CommonParams& common) {

@@ -41,6 +41,15 @@ void write_msh(const Mesh& mesh, const std::string& path);
 // Lower level, shared by the builders and read_msh.
 // Initializes the gmsh API once per process (quiet, single-threaded); cheap to repeat.
 void initialize_gmsh();
+// A fresh gmsh model for one build or file operation, removed when the scope ends
+// (also on errors).
+class ScopedGmshModel {
+ public:
+  explicit ScopedGmshModel(const std::string& name);
+  ~ScopedGmshModel();
+  ScopedGmshModel(const ScopedGmshModel&) = delete;
+  ScopedGmshModel& operator=(const ScopedGmshModel&) = delete;
+};
 // Extracts the Mesh of the current gmsh model: its 4- or 10-node tetrahedra (all of
 // them must lie in a volume physical group), the triangles of every surface
 // physical group (stored once per group, oriented outward from their tetrahedron),

@@ -260,18 +260,6 @@ Faces surface_faces(const std::vector<PhysicalGroup>& groups, const RowMatrixXi&
   return out;
 }
 
-// Guards a model created for one operation: removes it when the scope ends.
-class ScopedGmshModel {
- public:
-  explicit ScopedGmshModel(const std::string& name) {
-    initialize_gmsh();
-    gmsh::model::add(name);
-  }
-  ~ScopedGmshModel() { gmsh::model::remove(); }
-  ScopedGmshModel(const ScopedGmshModel&) = delete;
-  ScopedGmshModel& operator=(const ScopedGmshModel&) = delete;
-};
-
 // Checks the file can be opened and is a .msh of format 4.x.
 void check_msh_header(const std::string& path) {
   std::ifstream in(path);
@@ -289,6 +277,13 @@ void check_msh_header(const std::string& path) {
 }
 
 }  // namespace
+
+ScopedGmshModel::ScopedGmshModel(const std::string& name) {
+  initialize_gmsh();
+  gmsh::model::add(name);
+}
+
+ScopedGmshModel::~ScopedGmshModel() { gmsh::model::remove(); }
 
 void initialize_gmsh() {
   static std::once_flag once;

@@ -57,18 +57,6 @@ struct Assembly {
   double scale = 0.0;                     // largest body dimension (for tolerances)
 };
 
-// A fresh gmsh model for one build, removed when the scope ends (also on errors).
-class ScopedModel {
- public:
-  explicit ScopedModel(const std::string& name) {
-    initialize_gmsh();
-    gmsh::model::add(name);
-  }
-  ~ScopedModel() { gmsh::model::remove(); }
-  ScopedModel(const ScopedModel&) = delete;
-  ScopedModel& operator=(const ScopedModel&) = delete;
-};
-
 // Representative point (centroid of the first triangle) and node box of a meshed surface.
 struct SurfaceSample {
   Vec3 point = Vec3::Zero();
@@ -130,7 +118,7 @@ void add_group(int dim, const std::vector<int>& tags, const std::string& name) {
 }
 
 Mesh mesh_assembly(const Assembly& assembly, double mesh_size, int order, const std::string& source) {
-  ScopedModel model("morphfem_robot");
+  ScopedGmshModel model("morphfem_robot");
   namespace occ = gmsh::model::occ;
   gmsh::vectorpair boxes;
   for (const Piece& piece : assembly.pieces) {

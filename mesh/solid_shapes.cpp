@@ -19,18 +19,6 @@ namespace {
 
 constexpr double kHuge = std::numeric_limits<double>::max();
 
-// A fresh gmsh model for one build, removed (with its size fields) when the scope ends.
-class ScopedShapeModel {
- public:
-  explicit ScopedShapeModel(const std::string& name) {
-    initialize_gmsh();
-    gmsh::model::add(name);
-  }
-  ~ScopedShapeModel() { gmsh::model::remove(); }
-  ScopedShapeModel(const ScopedShapeModel&) = delete;
-  ScopedShapeModel& operator=(const ScopedShapeModel&) = delete;
-};
-
 // The same meshing options as the other builders (geometry.cpp): target size
 // mesh_size [m] at every CAD point, curved P2 mid-nodes, deterministic Delaunay 3-D.
 // A background size field, if set, can only refine below mesh_size.
@@ -107,7 +95,7 @@ Mesh build_hemisphere(const ParamSet& params) {
   const double refine_radius = params.number_in("refine_radius", 0.0, radius, radius / 4);
   const bool quarter = params.integer_in("quarter", 0, 1, 1) == 1;
 
-  ScopedShapeModel model("morphfem_hemisphere");
+  ScopedGmshModel model("morphfem_hemisphere");
   namespace occ = gmsh::model::occ;
   // Lower half-ball (quarter: x, y >= 0) = ball intersected with a box below z = 0.
   const double reach = 1.5 * radius;
@@ -155,7 +143,7 @@ Mesh build_solid_cylinder(const ParamSet& params) {
   const double length = params.number_in("length", 1e-12, kHuge);
   const double inner_radius = params.number_in("inner_radius", 0.0, radius * (1 - 1e-6), 0.0);
 
-  ScopedShapeModel model("morphfem_solid_cylinder");
+  ScopedGmshModel model("morphfem_solid_cylinder");
   namespace occ = gmsh::model::occ;
   const int outer = occ::addCylinder(0, 0, 0, 0, length, 0, radius);
   if (inner_radius > 0) {
