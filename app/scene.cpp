@@ -11,6 +11,7 @@
 #include "actuation/voxel_growth.h"
 #include "core/errors.h"
 #include "fem/elastic.h"
+#include "optim/calibration_file.h"
 
 namespace morphfem {
 
@@ -18,6 +19,7 @@ namespace {
 
 struct Reader {
   std::string file;
+  Scene* scene = nullptr;  // where calibrated values are recorded
 
   std::string at(const YAML::Node& node) const {
     const YAML::Mark m = node.Mark();
@@ -45,6 +47,31 @@ struct Reader {
     } catch (const YAML::Exception&) {
       fail(node, key, "expected a number, got '" + node.Scalar() + "'");
     }
+  }
+  // A number, or a value from a calibration file: {calibration: FILE, parameter: NAME}
+  // (FILE relative to the scene). The use is recorded in the scene (summary.json).
+  double calibrated_number(const YAML::Node& node, const std::string& key) const {
+    if (!node.IsMap()) return number(node, key);
+    allow(node, key, {"calibration", "parameter"});
+    if (!node["calibration"] || !node["parameter"])
+      fail(node, key, "a calibrated value needs {calibration: FILE, parameter: NAME}");
+    std::filesystem::path path = text(node["calibration"], key + ".calibration");
+    if (path.is_relative()) path = std::filesystem::path(file).parent_path() / path;
+    const Calibration calibration = read_calibration_file(path.string());  // its errors name its file and line
+    const std::string name = text(node["parameter"], key + ".parameter");
+    const CalibratedValue* value = nullptr;
+    std::string known;
+    for (const auto& [n, v] : calibration.parameters) {
+      if (n == name) value = &v;
+      known += (known.empty() ? "" : ", ") + n;
+    }
+    if (!value)
+      fail(node["parameter"], key + ".parameter",
+           "'" + path.string() + "' has no parameter '" + name + "' (it has: " + known + ")");
+    if (scene)
+      scene->calibrations.push_back(
+          {key, path.string(), sha256_file(path.string()), calibration.kind, name, value->value, value->std_error});
+    return value->value;
   }
   Eigen::Vector3d vector3(const YAML::Node& node, const std::string& key) const {
     if (!node.IsSequence() || node.size() != 3) fail(node, key, "expected a list of 3 numbers [x, y, z]");
@@ -128,12 +155,12 @@ Scene read_scene(const std::string& path) {
 }
 
 Scene scene_from_yaml(const YAML::Node& root, const std::string& path) {
-  Reader r{path};
+  Scene scene;
+  Reader r{path, &scene};
   if (!root.IsMap()) throw InputError(path, "a scene must be a mapping with keys geometry/mesh, materials, ...");
   r.allow(root, "",
           {"name", "geometry", "mesh", "materials", "boundary", "loads", "solver", "output", "dynamics", "contact",
            "actuation", "environment"});
-  Scene scene;
   scene.source = path;
   if (root["name"]) scene.name = r.text(root["name"], "name");
 
@@ -379,7 +406,7 @@ Scene scene_from_yaml(const YAML::Node& root, const std::string& path) {
         region.surface = r.text(reg["surface"], "contact.friction.regions.surface");
         // mu: a constant or a table of (time, mu); mu sets both coefficients.
         auto coefficient = [&](const YAML::Node& node, const std::string& key) {
-          if (node.IsScalar()) return TimeFunction::constant(r.number(node, key));
+          if (node.IsScalar() || node.IsMap()) return TimeFunction::constant(r.calibrated_number(node, key));
           return r.ramp_or_table(node, key, end);
         };
         const YAML::Node both = reg["mu"];
@@ -493,8 +520,9 @@ Scene scene_from_yaml(const YAML::Node& root, const std::string& path) {
     if (const auto f = a["feet"]) {
       r.allow(f, key + ".feet", {"foot_a", "foot_b", "mu_active", "mu_inactive"});
       if (!scene.ground_contact) r.fail(f, key + ".feet", "foot friction needs contact.ground");
-      const double mu_active = f["mu_active"] ? r.number(f["mu_active"], key + ".feet.mu_active") : 2.0;
-      const double mu_inactive = f["mu_inactive"] ? r.number(f["mu_inactive"], key + ".feet.mu_inactive") : 1e-4;
+      const double mu_active = f["mu_active"] ? r.calibrated_number(f["mu_active"], key + ".feet.mu_active") : 2.0;
+      const double mu_inactive =
+          f["mu_inactive"] ? r.calibrated_number(f["mu_inactive"], key + ".feet.mu_inactive") : 1e-4;
       scene.friction = true;
       for (const auto& [foot, channel] :
            {std::pair<const char*, int>{"foot_a", kChannelFootA}, {"foot_b", kChannelFootB}}) {

@@ -38,6 +38,8 @@
 //     friction: {eps_v: 1e-4, lag_updates: 0,
 //                regions: [{surface: zmin, mu_static: 0.5, mu_kinetic: 0.4}]}
 //                # mu: a number or a table [[t, mu], ...] (coefficients that change over time)
+//                # or a calibrated value {calibration: FILE, parameter: mu_static}
+//                # (`morphfem calibrate friction` writes FILE; also for feet.mu_active/inactive)
 //     self: {pairs: [[cavity_top, cavity_bottom]], dhat: 0, kappa: 0, inflation: 0}
 //           # surfaces that may touch (a name twice: within one surface); 0: defaults
 //           # (contact/self_contact.h: dhat 1e-3 x box diagonal, kappa 3 mu, inflation 20 dhat)
@@ -135,6 +137,12 @@ struct Scene {
   bool self_contact = false;  // self-contact between declared surface pairs
   SelfContactSpec self_contact_spec;
   std::string schedule_file;  // the actuation schedule, if any (its loads are in cavities/friction)
+  // Values taken from calibration files (optim/calibration_file.h), recorded in summary.json.
+  struct CalibrationUse {
+    std::string key, file, sha256, kind, parameter;
+    double value = 0, std_error = 0;
+  };
+  std::vector<CalibrationUse> calibrations;
   // Prescribed growth (active strain) of volume regions: stretches (g_x, g_y, g_z)(t).
   std::vector<std::pair<std::string, std::function<Eigen::Vector3d(double)>>> growth;
   GaitSpec gait;

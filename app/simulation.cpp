@@ -493,6 +493,21 @@ SimulationResult run_scene(const Scene& scene, MPI_Comm comm, const RunOptions& 
         }
         write_file_atomic(tmp_dir + "/trajectory.csv", csv);
       }
+      if (!scene.calibrations.empty()) {  // which calibration (and its checksum) produced which value
+        std::vector<Json> used;
+        for (const auto& c : scene.calibrations) {
+          Json j;
+          j.add("key", c.key)
+              .add("file", c.file)
+              .add("sha256", c.sha256)
+              .add("kind", c.kind)
+              .add("parameter", c.parameter)
+              .add("value", c.value)
+              .add("std_error", c.std_error);
+          used.push_back(j);
+        }
+        summary.add("calibrations", used);
+      }
       write_file_atomic(tmp_dir + "/summary.json", summary.str(true) + "\n");
       commit_output_dir(tmp_dir, scene.output_dir);
       result.output_dir = scene.output_dir;

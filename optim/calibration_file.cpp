@@ -115,7 +115,7 @@ std::string calibration_yaml(const Calibration& c) {
     o << (first ? "" : ", ") << k << ": " << quoted(v);
     first = false;
   }
-  o << "}\ndata:\n";
+  o << "}\ndata:" << (c.data.empty() ? " []\n" : "\n");
   for (const auto& d : c.data)
     o << "  - {file: " << quoted(d.file) << ", sha256: " << quoted(d.sha256) << ", specimen: " << quoted(d.specimen)
       << "}\n";
