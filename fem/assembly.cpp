@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numeric>
 #include <stdexcept>
 
 #include "fem/petsc_check.h"
@@ -43,6 +44,9 @@ Mat Assembler::create_matrix() const {
   Mat m;
   PETSC_CHECK(MatDuplicate(pattern_, MAT_DO_NOT_COPY_VALUES, &m));
   PETSC_CHECK(MatSetOption(m, MAT_ROW_ORIENTED, PETSC_FALSE));  // Eigen is column-major
+  // The coordinate map of hessian() (PETSc may modify the index arrays it is given).
+  std::vector<PetscInt> i = coo_i_, j = coo_j_;
+  PETSC_CHECK(MatSetPreallocationCOO(m, static_cast<PetscCount>(i.size()), i.data(), j.data()));
   return m;
 }
 
@@ -115,6 +119,31 @@ void Assembler::setup() {
     PetscScalar zero = 0.0;
     PETSC_CHECK(MatSetValues(pre, 1, &d, 1, &d, &zero, ADD_VALUES));  // every diagonal
   }
+  // The same entries as a coordinate list, in the order hessian() visits them.
+  coo_i_.clear();
+  coo_j_.clear();
+  coo_offset_.assign(terms_.size(), {});
+  for (size_t t = 0; t < terms_.size(); ++t) {
+    coo_offset_[t].resize(terms_[t]->n_pieces());
+    for (int k = 0; k < terms_[t]->n_pieces(); ++k) {
+      terms_[t]->piece_nodes(k, nodes);
+      idx.clear();
+      for (int n : nodes)
+        for (int i = 0; i < 3; ++i) idx.push_back(constrained_[3 * n + i] ? -1 : 3 * n + i);
+      coo_offset_[t][k] = coo_i_.size();
+      for (PetscInt col : idx)
+        for (PetscInt row : idx) {
+          coo_i_.push_back(row);
+          coo_j_.push_back(col);
+        }
+    }
+  }
+  coo_diagonal_ = coo_i_.size();
+  for (PetscInt d = owned_dof_begin(); d < owned_dof_end(); ++d) {  // every diagonal (1 if constrained)
+    coo_i_.push_back(d);
+    coo_j_.push_back(d);
+  }
+  coo_v_.assign(coo_i_.size(), 0.0);
   PETSC_CHECK(MatAssemblyBegin(pre, MAT_FINAL_ASSEMBLY));
   PETSC_CHECK(MatAssemblyEnd(pre, MAT_FINAL_ASSEMBLY));
   if (pattern_) MatDestroy(&pattern_);
@@ -195,18 +224,26 @@ double Assembler::gradient(Vec u, Vec gvec) {
 }
 
 void Assembler::hessian(Vec u, Mat Hmat) {
-  PETSC_CHECK(MatZeroEntries(Hmat));
+  // Values go into the coordinate list built by setup() and reach PETSc in one
+  // MatSetValuesCOO: measured on the voxel robot (3,060 dofs, P1), per-piece
+  // MatSetValues took ~40 % of the run, most of it searching for columns.
   sweep(u, false, true,
-        [&](size_t, int, const std::vector<PetscInt>& idx, double energy, const Eigen::VectorXd&,
+        [&](size_t t, int k, const std::vector<PetscInt>& idx, double energy, const Eigen::VectorXd&,
             const Eigen::MatrixXd& H) {
-          if (!std::isfinite(energy)) return;
-          const PetscInt n = static_cast<PetscInt>(idx.size());
-          PETSC_CHECK(MatSetValues(Hmat, n, idx.data(), n, idx.data(), H.data(), ADD_VALUES));
+          if (static_cast<std::size_t>(k) >= coo_offset_[t].size())
+            throw std::logic_error("Assembler::hessian: a term gained pieces without setup()");
+          const std::size_t n = idx.size(), begin = coo_offset_[t][k];
+          if (begin + n * n > coo_diagonal_ ||
+              (k + 1 < static_cast<int>(coo_offset_[t].size()) && coo_offset_[t][k + 1] != begin + n * n))
+            throw std::logic_error("Assembler::hessian: a piece changed its nodes without setup()");
+          if (std::isfinite(energy))
+            std::copy(H.data(), H.data() + n * n, coo_v_.begin() + static_cast<long>(begin));
+          else
+            std::fill_n(coo_v_.begin() + static_cast<long>(begin), n * n, 0.0);
         });
   for (PetscInt d = owned_dof_begin(); d < owned_dof_end(); ++d)
-    if (constrained_[d]) PETSC_CHECK(MatSetValue(Hmat, d, d, 1.0, ADD_VALUES));
-  PETSC_CHECK(MatAssemblyBegin(Hmat, MAT_FINAL_ASSEMBLY));
-  PETSC_CHECK(MatAssemblyEnd(Hmat, MAT_FINAL_ASSEMBLY));
+    coo_v_[coo_diagonal_ + static_cast<std::size_t>(d - owned_dof_begin())] = constrained_[d] ? 1.0 : 0.0;
+  PETSC_CHECK(MatSetValuesCOO(Hmat, coo_v_.data(), INSERT_VALUES));
 }
 
 RowMatrixXd Assembler::gather_all(Vec u) const {

@@ -86,6 +86,13 @@ class Assembler {
   Vec ghost_vec_ = nullptr;
   VecScatter scatter_ = nullptr;
   Mat pattern_ = nullptr;  // preallocated template matrix
+  // Hessian assembly in coordinate form (MatSetPreallocationCOO / MatSetValuesCOO):
+  // every piece's n x n block at a fixed offset, column-major like Eigen, then the
+  // constrained diagonals. PETSc sums repeated entries; index -1 entries are ignored.
+  std::vector<PetscInt> coo_i_, coo_j_;
+  std::vector<PetscScalar> coo_v_;
+  std::vector<std::vector<std::size_t>> coo_offset_;  // [term][piece] -> first value
+  std::size_t coo_diagonal_ = 0;                      // first constrained-diagonal value
 };
 
 }  // namespace morphfem
