@@ -65,12 +65,31 @@ const std::vector<RobotFidelity>& robot_fidelity_levels() {
 }
 
 const RobotFidelity& find_robot_fidelity(const std::string& name) {
+  // A custom level "MESH_SIZE:ORDER:MAX_STEP" (m, 1|2, s), e.g. 0.02:1:0.025.
+  if (name.find(':') != std::string::npos) {
+    static std::vector<RobotFidelity> custom;  // stable addresses for the returned references
+    for (const auto& level : custom)
+      if (level.name == name) return level;
+    RobotFidelity level;
+    level.name = name;
+    char colon1 = 0, colon2 = 0;
+    std::istringstream in(name);
+    if (!(in >> level.mesh_size >> colon1 >> level.order >> colon2 >> level.max_step) || colon1 != ':' ||
+        colon2 != ':' || !(in >> std::ws).eof() || !(level.mesh_size > 0) || (level.order != 1 && level.order != 2) ||
+        !(level.max_step > 0))
+      throw InputError("--fidelity", "a custom level is MESH_SIZE:ORDER:MAX_STEP (m, 1 or 2, s), got '" + name + "'");
+    custom.reserve(64);
+    if (custom.size() == custom.capacity()) throw InputError("--fidelity", "too many custom levels");
+    custom.push_back(level);
+    return custom.back();
+  }
   std::string known;
   for (const auto& level : robot_fidelity_levels()) {
     if (level.name == name) return level;
     known += (known.empty() ? "" : ", ") + level.name;
   }
-  throw InputError("--fidelity", "unknown robot fidelity level '" + name + "' (known: " + known + ")");
+  throw InputError("--fidelity",
+                   "unknown robot fidelity level '" + name + "' (known: " + known + ", or MESH_SIZE:ORDER:MAX_STEP)");
 }
 
 Schedule voxel_study_schedule(Schedule schedule) {
