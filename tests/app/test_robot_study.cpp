@@ -63,6 +63,16 @@ TEST(RobotStudy, CaseSetsScheduleSlopeHeadingAndFidelityInTheTemplate) {
   EXPECT_THROW(find_robot_fidelity("9"), InputError);
 }
 
+TEST(RobotStudy, CustomFidelityLevelsParseAndBadOnesAreRefused) {
+  const RobotFidelity& l = find_robot_fidelity("0.01:2:0.1");
+  EXPECT_DOUBLE_EQ(l.mesh_size, 0.01);
+  EXPECT_EQ(l.order, 2);
+  EXPECT_DOUBLE_EQ(l.max_step, 0.1);
+  EXPECT_EQ(&find_robot_fidelity("0.01:2:0.1"), &l);  // the same level again
+  for (const char* bad : {"0.01:3:0.1", "0.01:1", "-1:1:0.1", "0.01:1:0", "0.01:1:0.1x", "a:b:c"})
+    EXPECT_THROW(find_robot_fidelity(bad), InputError) << bad;
+}
+
 TEST(RobotStudy, BadInlineScheduleNamesTheScene) {
   YAML::Node doc = robot_scene_yaml(baseline("inch_flat"), find_robot_fidelity("0"), "");
   doc["actuation"]["schedule"]["matrix"][3] = "10102010";
