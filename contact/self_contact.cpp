@@ -236,8 +236,18 @@ void surface_triangles(const Mesh& mesh, const std::vector<int>& faces, std::vec
 
 double point_triangle_distance(const Eigen::Matrix<double, 4, 3>& x) { return plain_distance(x); }
 
-// E = A kappa dhat phi(d/dhat), d = sqrt(d2): derivatives by the chain rule on
-// the exact Dual derivatives of d2 for the closest feature.
+// E = A kappa dhat phi(d/dhat), d = sqrt(d2) [J], with its gradient and Hessian
+// carried by the chain rule from the exact Dual derivatives of d2.
+static Dual barrier_of_squared_distance(const Dual& d2, double area, double kappa, double dhat) {
+  const double d = std::sqrt(d2.v);
+  const Dual dist = chain(d2, d, 0.5 / d, -0.25 / (d * d * d));
+  double phi, dphi, d2phi;
+  log_barrier(d / dhat, phi, &dphi, &d2phi);
+  const double scale = area * kappa;
+  return chain(dist, scale * dhat * phi, scale * dphi, scale * d2phi / dhat);
+}
+
+// Point-triangle: the barrier of the squared distance to the closest feature.
 double point_triangle_barrier(const Eigen::Matrix<double, 4, 3>& x, double area, double kappa, double dhat,
                               Eigen::VectorXd* g, Eigen::MatrixXd* H) {
   if (g) g->setZero(12);
@@ -247,12 +257,7 @@ double point_triangle_barrier(const Eigen::Matrix<double, 4, 3>& x, double area,
   if (d_plain >= dhat) return 0.0;
   const Dual d2 = squared_distance(x, closest_feature(x));
   if (!(d2.v > 0)) return std::numeric_limits<double>::infinity();
-  const double d = std::sqrt(d2.v);
-  const Dual dist = chain(d2, d, 0.5 / d, -0.25 / (d * d * d));
-  double phi, dphi, d2phi;
-  log_barrier(d / dhat, phi, &dphi, &d2phi);
-  const double scale = area * kappa;
-  const Dual e = chain(dist, scale * dhat * phi, scale * dphi, scale * d2phi / dhat);
+  const Dual e = barrier_of_squared_distance(d2, area, kappa, dhat);
   if (g) *g = e.g;
   if (H) *H = e.H;
   return e.v;
@@ -276,12 +281,7 @@ double edge_edge_barrier(const Eigen::Matrix<double, 4, 3>& x, double area, doub
   if (d_plain >= dhat) return 0.0;
   const Dual d2 = squared_edge_distance(x, closest_edge_feature(x));
   if (!(d2.v > 0)) return std::numeric_limits<double>::infinity();
-  const double d = std::sqrt(d2.v);
-  const Dual dist = chain(d2, d, 0.5 / d, -0.25 / (d * d * d));
-  double phi, dphi, d2phi;
-  log_barrier(d / dhat, phi, &dphi, &d2phi);
-  const double scale = area * kappa;
-  const Dual barrier = chain(dist, scale * dhat * phi, scale * dphi, scale * d2phi / dhat);
+  const Dual barrier = barrier_of_squared_distance(d2, area, kappa, dhat);
   const std::array<DualVec, 4> v = dual_positions(x);
   const DualVec n = cross(sub(v[1], v[0]), sub(v[3], v[2]));
   const Dual c = dot(n, n);
