@@ -20,7 +20,6 @@ Assembler::Assembler(const Mesh& mesh, const Partition& partition, MPI_Comm comm
 Assembler::~Assembler() {
   if (ghost_vec_) VecDestroy(&ghost_vec_);
   if (scatter_) VecScatterDestroy(&scatter_);
-  if (pattern_) MatDestroy(&pattern_);
 }
 
 void Assembler::add_term(std::shared_ptr<EnergyTerm> term) { terms_.push_back(std::move(term)); }
@@ -42,11 +41,17 @@ Vec Assembler::create_vector() const {
 
 Mat Assembler::create_matrix() const {
   Mat m;
-  PETSC_CHECK(MatDuplicate(pattern_, MAT_DO_NOT_COPY_VALUES, &m));
-  PETSC_CHECK(MatSetOption(m, MAT_ROW_ORIENTED, PETSC_FALSE));  // Eigen is column-major
-  // The coordinate map of hessian() (PETSc may modify the index arrays it is given).
+  const PetscInt n_local = owned_dof_end() - owned_dof_begin();
+  PETSC_CHECK(MatCreate(comm_, &m));
+  PETSC_CHECK(MatSetType(m, MATAIJ));
+  PETSC_CHECK(MatSetSizes(m, n_local, n_local, n_dofs(), n_dofs()));
+  PETSC_CHECK(MatSetBlockSize(m, 3));
+  // The pattern and the coordinate map of hessian() (PETSc may modify the index
+  // arrays it is given).
   std::vector<PetscInt> i = coo_i_, j = coo_j_;
   PETSC_CHECK(MatSetPreallocationCOO(m, static_cast<PetscCount>(i.size()), i.data(), j.data()));
+  PETSC_CHECK(MatSetOption(m, MAT_ROW_ORIENTED, PETSC_FALSE));  // Eigen is column-major
+  PETSC_CHECK(MatSetOption(m, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE));
   return m;
 }
 
@@ -95,31 +100,9 @@ void Assembler::setup() {
   PETSC_CHECK(ISDestroy(&is));
   PETSC_CHECK(VecDestroy(&u));
 
-  // Nonzero pattern: a dry run of the Hessian assembly into a MATPREALLOCATOR.
-  const PetscInt n_local = owned_dof_end() - owned_dof_begin();
-  Mat pre;
-  PETSC_CHECK(MatCreate(comm_, &pre));
-  PETSC_CHECK(MatSetType(pre, MATPREALLOCATOR));
-  PETSC_CHECK(MatSetSizes(pre, n_local, n_local, n_dofs(), n_dofs()));
-  PETSC_CHECK(MatSetBlockSize(pre, 3));
-  PETSC_CHECK(MatSetUp(pre));
+  // Nonzero pattern: every piece's entries as a coordinate list, in the order
+  // hessian() visits them, and every owned diagonal.
   std::vector<PetscInt> idx;
-  std::vector<PetscScalar> zeros;
-  for (const auto& term : terms_)
-    for (int k = 0; k < term->n_pieces(); ++k) {
-      term->piece_nodes(k, nodes);
-      idx.clear();
-      for (int n : nodes)
-        for (int i = 0; i < 3; ++i) idx.push_back(constrained_[3 * n + i] ? -1 : 3 * n + i);
-      zeros.assign(idx.size() * idx.size(), 0.0);
-      PETSC_CHECK(MatSetValues(pre, static_cast<PetscInt>(idx.size()), idx.data(), static_cast<PetscInt>(idx.size()),
-                               idx.data(), zeros.data(), ADD_VALUES));
-    }
-  for (PetscInt d = owned_dof_begin(); d < owned_dof_end(); ++d) {
-    PetscScalar zero = 0.0;
-    PETSC_CHECK(MatSetValues(pre, 1, &d, 1, &d, &zero, ADD_VALUES));  // every diagonal
-  }
-  // The same entries as a coordinate list, in the order hessian() visits them.
   coo_i_.clear();
   coo_j_.clear();
   coo_offset_.assign(terms_.size(), {});
@@ -144,16 +127,6 @@ void Assembler::setup() {
     coo_j_.push_back(d);
   }
   coo_v_.assign(coo_i_.size(), 0.0);
-  PETSC_CHECK(MatAssemblyBegin(pre, MAT_FINAL_ASSEMBLY));
-  PETSC_CHECK(MatAssemblyEnd(pre, MAT_FINAL_ASSEMBLY));
-  if (pattern_) MatDestroy(&pattern_);
-  PETSC_CHECK(MatCreate(comm_, &pattern_));
-  PETSC_CHECK(MatSetType(pattern_, MATAIJ));
-  PETSC_CHECK(MatSetSizes(pattern_, n_local, n_local, n_dofs(), n_dofs()));
-  PETSC_CHECK(MatSetBlockSize(pattern_, 3));
-  PETSC_CHECK(MatPreallocatorPreallocate(pre, PETSC_TRUE, pattern_));
-  PETSC_CHECK(MatSetOption(pattern_, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE));
-  PETSC_CHECK(MatDestroy(&pre));
 }
 
 const std::vector<double>& Assembler::gather(Vec u) {

@@ -34,7 +34,7 @@ class Assembler {
   // Marks dofs as constrained (global dof ids; the same list on every rank).
   void set_constrained(const std::vector<int>& dofs);
   const std::vector<char>& constrained() const { return constrained_; }
-  // Builds the ghost scatter and the matrix nonzero pattern; call after the last
+  // Builds the ghost scatter and the Hessian's coordinate list; call after the last
   // add_term / set_constrained and again if the terms' pieces change.
   void setup();
 
@@ -85,7 +85,6 @@ class Assembler {
   std::vector<double> ghost_u_;    // 3 per ghost node
   Vec ghost_vec_ = nullptr;
   VecScatter scatter_ = nullptr;
-  Mat pattern_ = nullptr;  // preallocated template matrix
   // Hessian assembly in coordinate form (MatSetPreallocationCOO / MatSetValuesCOO):
   // every piece's n x n block at a fixed offset, column-major like Eigen, then the
   // constrained diagonals. PETSc sums repeated entries; index -1 entries are ignored.
