@@ -56,17 +56,22 @@ Scene verification_scene(const std::string& name, ParamSet geometry, ParamSet ma
 
 VerificationRecord verification_record(const std::string& case_name, const std::string& quantity, int level, int order,
                                        double h, const SimulationResult& r) {
+  return verification_record(case_name, quantity, level, order, h, r.dofs, r.stats);
+}
+
+VerificationRecord verification_record(const std::string& case_name, const std::string& quantity, int level, int order,
+                                       double h, long dofs, const RunStats& stats) {
   VerificationRecord rec;
   rec.case_name = case_name;
   rec.quantity = quantity;
   rec.level = level;
   rec.order = order;
   rec.h = h;
-  rec.dofs = r.dofs;
-  rec.wall_s = r.stats.wall_s;
-  rec.newton_its = r.stats.newton_its;
-  rec.steps = r.stats.steps;
-  rec.step_cuts = r.stats.step_cuts;
+  rec.dofs = dofs;
+  rec.wall_s = stats.wall_s;
+  rec.newton_its = stats.newton_its;
+  rec.steps = stats.steps;
+  rec.step_cuts = stats.step_cuts;
   return rec;
 }
 

@@ -23,6 +23,9 @@ Scene verification_scene(const std::string& name, ParamSet geometry, ParamSet ma
 // A record filled with the run's cost (dofs, wall time, Newton iterations, steps, cuts).
 VerificationRecord verification_record(const std::string& case_name, const std::string& quantity, int level, int order,
                                        double h, const SimulationResult& r);
+// The same from a run's size and statistics (cases that run their own solver loop).
+VerificationRecord verification_record(const std::string& case_name, const std::string& quantity, int level, int order,
+                                       double h, long dofs, const RunStats& stats);
 // Throws SolveError naming the case if the run did not complete.
 void require_completed(const SimulationResult& r, const std::string& what);
 

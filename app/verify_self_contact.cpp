@@ -318,20 +318,11 @@ void tube_vacuum_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<Verif
       failure = e.what();
     }
     const auto record = [&](const std::string& quantity, double value, double reference, double rel_error) {
-      VerificationRecord rec;
-      rec.case_name = "tube_vacuum";
-      rec.quantity = quantity;
-      rec.level = static_cast<int>(level);
-      rec.order = order;
-      rec.h = h;
+      VerificationRecord rec =
+          verification_record("tube_vacuum", quantity, static_cast<int>(level), order, h, t.dofs, t.stats);
       rec.value = value;
       rec.reference = reference;
       rec.rel_error = rel_error;
-      rec.dofs = t.dofs;
-      rec.wall_s = t.stats.wall_s;
-      rec.newton_its = t.stats.newton_its;
-      rec.steps = t.stats.steps;
-      rec.step_cuts = t.stats.step_cuts;
       return rec;
     };
     if (!failure.empty()) {
