@@ -57,22 +57,6 @@ int divisions(double length, double mesh_size) {
   return std::max(1, static_cast<int>(std::lround(length / mesh_size)));
 }
 
-// Meshes the synchronized model in 3-D with target size h and the element order;
-// second-order nodes are placed on the curved geometry.
-void generate_mesh(const CommonParams& common) {
-  gmsh::option::setNumber("Mesh.MeshSizeMin", 0.0);
-  gmsh::option::setNumber("Mesh.MeshSizeMax", common.mesh_size);
-  gmsh::option::setNumber("Mesh.MeshSizeFromCurvature", 0);
-  gmsh::option::setNumber("Mesh.ElementOrder", common.order);
-  gmsh::option::setNumber("Mesh.SecondOrderLinear", 0);
-  gmsh::option::setNumber("Mesh.HighOrderOptimize", 0);
-  gmsh::option::setNumber("Mesh.Algorithm3D", 1);  // Delaunay: deterministic, single-threaded
-  gmsh::vectorpair points;
-  gmsh::model::getEntities(points, 0);
-  gmsh::model::mesh::setSize(points, common.mesh_size);
-  gmsh::model::mesh::generate(3);
-}
-
 // Axis-aligned bounding box of the mesh nodes of one entity (tight, unlike CAD boxes).
 struct Box {
   Eigen::Vector3d min = Eigen::Vector3d::Constant(kHuge);
@@ -160,7 +144,7 @@ Mesh box_mesh(const Eigen::Vector3d& lengths, const CommonParams& common, bool s
   gmsh::model::occ::addBox(0, 0, 0, lengths(0), lengths(1), lengths(2));
   gmsh::model::occ::synchronize();
   if (structured) make_box_transfinite(lengths, common.mesh_size);
-  generate_mesh(common);
+  generate_tet_mesh(common.mesh_size, common.order);
   add_physical_groups(box_face_rules(lengths, names));
   return mesh_from_current_gmsh_model(source);
 }
@@ -280,7 +264,7 @@ Mesh build_thick_cylinder(const ParamSet& params) {
   occ::remove({{0, centre}});
   extrude_along_z(annulus, height, layers);
   occ::synchronize();
-  generate_mesh(common);
+  generate_tet_mesh(common.mesh_size, common.order);
 
   const double tol = 1e-6 * r_out, r_mid = 0.5 * (r_in + r_out);
   add_physical_groups({{"zmin", [=](const Box& b) { return b.max.z() < tol; }},
@@ -307,7 +291,7 @@ Mesh build_spherical_shell(const ParamSet& params) {
   const double box = 1.5 * r_out;
   occ::intersect(shell, {{3, occ::addBox(0, 0, 0, box, box, box)}}, octant, unused_map);
   occ::synchronize();
-  generate_mesh(common);
+  generate_tet_mesh(common.mesh_size, common.order);
 
   const double tol = 1e-6 * r_out, r_mid = 0.5 * (r_in + r_out);
   add_physical_groups({{"sym_x", [=](const Box& b) { return b.max.x() < tol; }},
@@ -340,7 +324,7 @@ Mesh build_cook_membrane(const ParamSet& params) {
     for (int edge : edges) gmsh::model::mesh::setTransfiniteCurve(edge, n + 1);
     gmsh::model::mesh::setTransfiniteSurface(trapezoid);
   }
-  generate_mesh(common);
+  generate_tet_mesh(common.mesh_size, common.order);
 
   const double tol = 1e-6 * 60 * scale;
   add_physical_groups({{"zmin", [=](const Box& bx) { return bx.max.z() < tol; }},

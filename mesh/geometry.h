@@ -41,6 +41,10 @@ void write_msh(const Mesh& mesh, const std::string& path);
 // Lower level, shared by the builders and read_msh.
 // Initializes the gmsh API once per process (quiet, single-threaded); cheap to repeat.
 void initialize_gmsh();
+// Meshes the synchronized current model in 3-D: target size mesh_size [m] at every
+// CAD point (a background size field can only refine below it), element order 1 or 2
+// with curved mid-nodes, deterministic single-threaded Delaunay.
+void generate_tet_mesh(double mesh_size, int order);
 // A fresh gmsh model for one build or file operation, removed when the scope ends
 // (also on errors).
 class ScopedGmshModel {

@@ -285,6 +285,20 @@ ScopedGmshModel::ScopedGmshModel(const std::string& name) {
 
 ScopedGmshModel::~ScopedGmshModel() { gmsh::model::remove(); }
 
+void generate_tet_mesh(double mesh_size, int order) {
+  gmsh::option::setNumber("Mesh.MeshSizeMin", 0.0);
+  gmsh::option::setNumber("Mesh.MeshSizeMax", mesh_size);
+  gmsh::option::setNumber("Mesh.MeshSizeFromCurvature", 0);
+  gmsh::option::setNumber("Mesh.ElementOrder", order);
+  gmsh::option::setNumber("Mesh.SecondOrderLinear", 0);  // curved P2 mid-nodes
+  gmsh::option::setNumber("Mesh.HighOrderOptimize", 0);
+  gmsh::option::setNumber("Mesh.Algorithm3D", 1);  // Delaunay: deterministic, single-threaded
+  gmsh::vectorpair points;
+  gmsh::model::getEntities(points, 0);
+  gmsh::model::mesh::setSize(points, mesh_size);
+  gmsh::model::mesh::generate(3);
+}
+
 void initialize_gmsh() {
   static std::once_flag once;
   std::call_once(once, [] {

@@ -97,21 +97,6 @@ bool inside_solid(const Assembly& assembly, const Vec3& p) {
                      [&](const Piece& piece) { return piece.box.contains(p, 0.0); });
 }
 
-// Meshes the synchronized model in 3-D with target size h and the element order.
-void generate_mesh(double mesh_size, int order) {
-  gmsh::option::setNumber("Mesh.MeshSizeMin", 0.0);
-  gmsh::option::setNumber("Mesh.MeshSizeMax", mesh_size);
-  gmsh::option::setNumber("Mesh.MeshSizeFromCurvature", 0);
-  gmsh::option::setNumber("Mesh.ElementOrder", order);
-  gmsh::option::setNumber("Mesh.SecondOrderLinear", 0);
-  gmsh::option::setNumber("Mesh.HighOrderOptimize", 0);
-  gmsh::option::setNumber("Mesh.Algorithm3D", 1);  // Delaunay: deterministic, single-threaded
-  gmsh::vectorpair points;
-  gmsh::model::getEntities(points, 0);
-  gmsh::model::mesh::setSize(points, mesh_size);
-  gmsh::model::mesh::generate(3);
-}
-
 void add_group(int dim, const std::vector<int>& tags, const std::string& name) {
   if (tags.empty()) throw std::logic_error("robot geometry: empty region " + name);
   gmsh::model::setPhysicalName(dim, gmsh::model::addPhysicalGroup(dim, tags), name);
@@ -130,7 +115,7 @@ Mesh mesh_assembly(const Assembly& assembly, double mesh_size, int order, const 
   std::vector<gmsh::vectorpair> unused_map;
   occ::fragment({boxes.front()}, gmsh::vectorpair(boxes.begin() + 1, boxes.end()), fragments, unused_map);
   occ::synchronize();
-  generate_mesh(mesh_size, order);
+  generate_tet_mesh(mesh_size, order);
 
   const double tol = 1e-9 * assembly.scale, probe = 1e-6 * assembly.scale;
 

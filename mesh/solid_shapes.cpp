@@ -19,23 +19,6 @@ namespace {
 
 constexpr double kHuge = std::numeric_limits<double>::max();
 
-// The same meshing options as the other builders (geometry.cpp): target size
-// mesh_size [m] at every CAD point, curved P2 mid-nodes, deterministic Delaunay 3-D.
-// A background size field, if set, can only refine below mesh_size.
-void generate_shape_mesh(double mesh_size, int order) {
-  gmsh::option::setNumber("Mesh.MeshSizeMin", 0.0);
-  gmsh::option::setNumber("Mesh.MeshSizeMax", mesh_size);
-  gmsh::option::setNumber("Mesh.MeshSizeFromCurvature", 0);
-  gmsh::option::setNumber("Mesh.ElementOrder", order);
-  gmsh::option::setNumber("Mesh.SecondOrderLinear", 0);
-  gmsh::option::setNumber("Mesh.HighOrderOptimize", 0);
-  gmsh::option::setNumber("Mesh.Algorithm3D", 1);
-  gmsh::vectorpair points;
-  gmsh::model::getEntities(points, 0);
-  gmsh::model::mesh::setSize(points, mesh_size);
-  gmsh::model::mesh::generate(3);
-}
-
 // Bounding box of the mesh nodes of one surface entity (tight, unlike CAD boxes).
 struct NodeBox {
   Eigen::Vector3d min = Eigen::Vector3d::Constant(kHuge);
@@ -121,7 +104,7 @@ Mesh build_hemisphere(const ParamSet& params) {
     gmsh::model::mesh::field::setNumber(size, "DistMax", refine_radius + 2 * (mesh_size - contact_size));
     gmsh::model::mesh::field::setAsBackgroundMesh(size);
   }
-  generate_shape_mesh(mesh_size, order);
+  generate_tet_mesh(mesh_size, order);  // a background size field can only refine below mesh_size
 
   const double tol = 1e-6 * radius;
   SurfaceNamer rules;
@@ -153,7 +136,7 @@ Mesh build_solid_cylinder(const ParamSet& params) {
     occ::cut({{3, outer}}, {{3, occ::addCylinder(0, -length, 0, 0, 3 * length, 0, inner_radius)}}, tube, unused_map);
   }
   occ::synchronize();
-  generate_shape_mesh(mesh_size, order);
+  generate_tet_mesh(mesh_size, order);  // a background size field can only refine below mesh_size
 
   const double tol = 1e-6 * std::max(radius, length), r_mid = 0.5 * (radius + inner_radius);
   SurfaceNamer rules{{"ymin", [=](const NodeBox& b) { return b.max.y() < tol; }},
