@@ -49,10 +49,38 @@ double cavity_face_integral(const ShapeTable& table, const std::array<bool, 3>& 
   return f;
 }
 
+double cavity_wall_integral(const ShapeTable& table, const std::array<bool, 3>& axes, int open_axis,
+                            const Eigen::MatrixXd& X, const Eigen::MatrixXd& x, Eigen::VectorXd* g,
+                            Eigen::MatrixXd* H) {
+  if (open_axis < 0) return cavity_face_integral(table, axes, x, g, H);
+  Eigen::MatrixXd frozen = x;
+  frozen.col(open_axis) = X.col(open_axis);
+  const double f = cavity_face_integral(table, axes, frozen, g, H);
+  for (Eigen::Index a = 0; a < x.rows(); ++a) {
+    const Eigen::Index j = 3 * a + open_axis;
+    if (g) (*g)[j] = 0.0;
+    if (H) {
+      H->row(j).setZero();
+      H->col(j).setZero();
+    }
+  }
+  return f;
+}
+
+void check_cavity_axes(const std::string& name, const std::array<bool, 3>& axes, int open_axis) {
+  if (!(axes[0] || axes[1] || axes[2]))
+    throw std::invalid_argument("cavity '" + name + "': volume_axes selects no axis");
+  if (open_axis < -1 || open_axis > 2) throw std::invalid_argument("cavity '" + name + "': open axis out of range");
+  if (open_axis >= 0)
+    for (int i = 0; i < 3; ++i)
+      if (axes[i] == (i == open_axis))
+        throw std::invalid_argument("cavity '" + name +
+                                    "': an open sleeve's volume axes must be the two axes other than its open axis");
+}
+
 CavityPressureTerm::CavityPressureTerm(const Mesh& mesh, const Partition& partition, int rank, CavitySpec spec)
     : mesh_(mesh), spec_(std::move(spec)) {
-  if (!(spec_.axes[0] || spec_.axes[1] || spec_.axes[2]))
-    throw std::invalid_argument("cavity '" + spec_.name + "': volume_axes selects no axis");
+  check_cavity_axes(spec_.name, spec_.axes, spec_.open_axis);
   std::vector<int> wall;
   for (const auto& surface : spec_.surfaces) {
     auto f = mesh.faces_of(surface);
@@ -74,7 +102,7 @@ double CavityPressureTerm::piece(int k, const PieceState& s, Eigen::VectorXd* g,
   // E_face = -p V_face = (p/|S|) int (S x).(a x b)
   const double scale = pressure_ / n_axes;
   const Eigen::MatrixXd x = s.X + s.u;
-  double f = cavity_face_integral(table_, spec_.axes, x, g, H);
+  double f = cavity_wall_integral(table_, spec_.axes, spec_.open_axis, s.X, x, g, H);
   if (g) *g *= scale;
   if (H) *H *= scale;
   return scale * f;
@@ -84,16 +112,20 @@ double CavityPressureTerm::volume(Assembler& assembler, Vec u) const {
   const auto& ghost = assembler.gather(u);
   const double n_axes = spec_.axes[0] + spec_.axes[1] + spec_.axes[2];
   std::vector<int> nodes;
-  Eigen::MatrixXd x;
+  Eigen::MatrixXd X, x;
   double local = 0.0;
   for (int k = 0; k < n_pieces(); ++k) {
     piece_nodes(k, nodes);
+    X.resize(nodes.size(), 3);
     x.resize(nodes.size(), 3);
     for (size_t a = 0; a < nodes.size(); ++a) {
       const int slot = assembler.node_slot(nodes[a]);
-      for (int i = 0; i < 3; ++i) x(a, i) = mesh_.X(nodes[a], i) + ghost[3 * slot + i];
+      for (int i = 0; i < 3; ++i) {
+        X(a, i) = mesh_.X(nodes[a], i);
+        x(a, i) = X(a, i) + ghost[3 * slot + i];
+      }
     }
-    local -= cavity_face_integral(table_, spec_.axes, x, nullptr, nullptr) / n_axes;
+    local -= cavity_wall_integral(table_, spec_.axes, spec_.open_axis, X, x, nullptr, nullptr) / n_axes;
   }
   double total = 0.0;
   MPI_Allreduce(&local, &total, 1, MPI_DOUBLE, MPI_SUM, assembler.comm());

@@ -10,6 +10,13 @@
 // vanishes (times n) on the missing faces, e.g. S = diag(1,1,0) for a quarter
 // cylinder with caps z = const: the missing faces then contribute nothing and V
 // is exact. The Hessian of -pV is the load stiffness; p > 0 inflates.
+//
+// An open sleeve (open_axis k, e.g. the core of a laminate bonded only along its long
+// edges, or a sleeve around a balloon) has no end caps: its wall coordinate along k is
+// taken at the reference value X_k inside V, so V = sum of cross-section areas times
+// reference lengths. The pressure then acts in the cross-section planes only: no force
+// along k and none from the missing caps (the plain S mask would put the caps' p A on
+// the rims). S must then be the other two axes.
 #pragma once
 #include <array>
 #include <string>
@@ -27,13 +34,23 @@ struct CavitySpec {
   std::vector<std::string> surfaces;           // wall surface regions
   std::array<bool, 3> axes{true, true, true};  // S: which coordinates enter V
   TimeFunction pressure;                       // p(t) [Pa], gauge
+  int open_axis = -1;                          // 0, 1, 2: an open sleeve along that axis
 };
+
+// Checks an axes mask and open axis (S non-empty; an open axis not in S and S the
+// other two); throws std::invalid_argument naming the cavity.
+void check_cavity_axes(const std::string& name, const std::array<bool, 3>& axes, int open_axis);
 
 // Kernel for one wall face (n nodes): f = int (S x).(a x b) dxi deta with
 // a = dx/dxi, b = dx/deta; gradient and Hessian w.r.t. nodal positions (3n).
 // Exposed for the finite-difference tests.
 double cavity_face_integral(const ShapeTable& table, const std::array<bool, 3>& axes, const Eigen::MatrixXd& x,
                             Eigen::VectorXd* g, Eigen::MatrixXd* H);
+
+// The same integral for a wall face at reference positions X and current positions x,
+// with the open axis (if any, >= 0) frozen at X: derivatives along it are zero.
+double cavity_wall_integral(const ShapeTable& table, const std::array<bool, 3>& axes, int open_axis,
+                            const Eigen::MatrixXd& X, const Eigen::MatrixXd& x, Eigen::VectorXd* g, Eigen::MatrixXd* H);
 
 class CavityPressureTerm : public EnergyTerm {
  public:

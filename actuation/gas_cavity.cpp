@@ -50,8 +50,7 @@ double first_nonpositive(double f0, double f1, double f2, double f3) {
 
 CavityVolumeTerm::CavityVolumeTerm(const Mesh& mesh, const Partition& partition, int rank, CavityWallSpec wall)
     : mesh_(mesh), wall_(std::move(wall)) {
-  if (!(wall_.axes[0] || wall_.axes[1] || wall_.axes[2]))
-    throw std::invalid_argument("cavity '" + wall_.name + "': volume axes select no axis");
+  check_cavity_axes(wall_.name, wall_.axes, wall_.open_axis);
   if (!(wall_.symmetry_factor >= 1.0))
     throw std::invalid_argument("cavity '" + wall_.name + "': symmetry_factor must be >= 1");
   n_axes_ = wall_.axes[0] + wall_.axes[1] + wall_.axes[2];
@@ -68,7 +67,7 @@ CavityVolumeTerm::CavityVolumeTerm(const Mesh& mesh, const Partition& partition,
   double model = 0.0;
   for (int f : all) {
     for (int a = 0; a < n; ++a) x.row(a) = mesh.X.row(mesh.faces(f, a));
-    model -= cavity_face_integral(table_, wall_.axes, x, nullptr, nullptr) / n_axes_;
+    model -= cavity_wall_integral(table_, wall_.axes, wall_.open_axis, x, x, nullptr, nullptr) / n_axes_;
   }
   reference_volume_ = wall_.symmetry_factor * model;
   if (!(reference_volume_ > 0))
@@ -85,8 +84,10 @@ void CavityVolumeTerm::piece_nodes(int k, std::vector<int>& nodes) const {
 
 // Meshed part's volume of face k: V_f = -(1/|S|) int (S x).(a x b), and its
 // derivatives w.r.t. the face's nodal positions.
-double CavityVolumeTerm::face_volume(int, const Eigen::MatrixXd& x, Eigen::VectorXd* g, Eigen::MatrixXd* H) const {
-  const double f = cavity_face_integral(table_, wall_.axes, x, g, H);
+double CavityVolumeTerm::face_volume(int k, const Eigen::MatrixXd& x, Eigen::VectorXd* g, Eigen::MatrixXd* H) const {
+  Eigen::MatrixXd X(x.rows(), 3);
+  for (Eigen::Index a = 0; a < x.rows(); ++a) X.row(a) = mesh_.X.row(mesh_.faces(faces_[k], a));
+  const double f = cavity_wall_integral(table_, wall_.axes, wall_.open_axis, X, x, g, H);
   if (g) *g *= -1.0 / n_axes_;
   if (H) *H *= -1.0 / n_axes_;
   return -f / n_axes_;

@@ -40,6 +40,7 @@ struct CavityWallSpec {
   std::vector<std::string> surfaces;           // wall surface regions (normals into the cavity)
   std::array<bool, 3> axes{true, true, true};  // S: which coordinates enter V (see cavity.h)
   double symmetry_factor = 1.0;                // s >= 1: copies of the meshed part in the cavity
+  int open_axis = -1;                          // an open sleeve along this axis (see cavity.h)
 };
 
 // Volume machinery common to both terms: owned wall faces, cached volume, the

@@ -102,6 +102,17 @@ struct Reader {
     }
     return out;
   }
+  // An open sleeve's axis (x, y or z) and the volume axes then implied (the other two),
+  // unless volume_axes says otherwise (checked by the cavity term).
+  void open_axis(const YAML::Node& c, const std::string& key, std::array<bool, 3>& axes, int& axis) const {
+    if (!c["open_axis"]) return;
+    const std::string name = text(c["open_axis"], key + ".open_axis");
+    if (name != "x" && name != "y" && name != "z")
+      fail(c["open_axis"], key + ".open_axis", "unknown axis '" + name + "' (allowed: x, y, z)");
+    axis = name[0] - 'x';
+    if (!c["volume_axes"])
+      for (int i = 0; i < 3; ++i) axes[i] = i != axis;
+  }
   // A map of scalars and numeric lists -> ParamSet (each value remembers its line).
   ParamSet params(const YAML::Node& map, const std::string& context) const {
     if (!map.IsMap()) fail(map, context, "expected a mapping of parameters");
@@ -262,7 +273,7 @@ Scene scene_from_yaml(const YAML::Node& root, const std::string& path) {
     if (const auto cs = l["cavities"]) {
       if (!cs.IsSequence()) r.fail(cs, "loads.cavities", "expected a list");
       for (const auto& c : cs) {
-        r.allow(c, "loads.cavities", {"name", "surfaces", "volume_axes", "pressure"});
+        r.allow(c, "loads.cavities", {"name", "surfaces", "volume_axes", "open_axis", "pressure"});
         CavitySpec spec;
         if (!c["surfaces"]) r.fail(c, "loads.cavities", "missing key 'surfaces'");
         if (!c["pressure"]) r.fail(c, "loads.cavities", "missing key 'pressure'");
@@ -270,6 +281,7 @@ Scene scene_from_yaml(const YAML::Node& root, const std::string& path) {
             c["name"] ? r.text(c["name"], "loads.cavities.name") : "cavity" + std::to_string(scene.cavities.size());
         spec.surfaces = r.texts(c["surfaces"], "loads.cavities.surfaces");
         if (c["volume_axes"]) spec.axes = r.axes(c["volume_axes"], "loads.cavities.volume_axes");
+        r.open_axis(c, "loads.cavities", spec.axes, spec.open_axis);
         spec.pressure = r.ramp_or_table(c["pressure"], "loads.cavities.pressure", end);
         scene.cavities.push_back(spec);
       }
@@ -279,14 +291,15 @@ Scene scene_from_yaml(const YAML::Node& root, const std::string& path) {
       for (const auto& c : gs) {
         const std::string key = "loads.gas_cavities";
         r.allow(c, key,
-                {"name", "surfaces", "volume_axes", "symmetry_factor", "temperature", "initial_gauge_pressure",
-                 "supply_pressure", "conductance"});
+                {"name", "surfaces", "volume_axes", "open_axis", "symmetry_factor", "temperature",
+                 "initial_gauge_pressure", "supply_pressure", "conductance"});
         GasCavitySpec spec;
         if (!c["surfaces"]) r.fail(c, key, "missing key 'surfaces'");
         spec.wall.name =
             c["name"] ? r.text(c["name"], key + ".name") : "gas" + std::to_string(scene.gas_cavities.size());
         spec.wall.surfaces = r.texts(c["surfaces"], key + ".surfaces");
         if (c["volume_axes"]) spec.wall.axes = r.axes(c["volume_axes"], key + ".volume_axes");
+        r.open_axis(c, key, spec.wall.axes, spec.wall.open_axis);
         auto positive = [&](const char* k, double& out) {
           if (!c[k]) return;
           out = r.number(c[k], key + "." + k);
@@ -445,7 +458,8 @@ Scene scene_from_yaml(const YAML::Node& root, const std::string& path) {
   if (const auto a = root["actuation"]) {
     const std::string key = "actuation";
     r.allow(a, key,
-            {"schedule", "start", "bladders", "growth", "timing", "core", "core_ramp_s", "volume_axes", "feet"});
+            {"schedule", "start", "bladders", "growth", "timing", "core", "core_ramp_s", "volume_axes",
+             "core_open_axis", "feet"});
     if (!a["schedule"]) r.fail(a, key, "missing key 'schedule' (a schedule file)");
     if (a["schedule"].IsMap()) {  // the schedule written inline, in the schedule file format
       YAML::Emitter text;
@@ -509,13 +523,19 @@ Scene scene_from_yaml(const YAML::Node& root, const std::string& path) {
     }
     if (a["core"]) {
       add_cavity(kChannelCore, r.text(a["core"], key + ".core"));
+      if (a["core_open_axis"]) {  // an open sleeve: its own axes (the other two), whatever volume_axes says
+        YAML::Node sleeve;
+        sleeve["open_axis"] = a["core_open_axis"];
+        r.open_axis(sleeve, key + ".core", scene.cavities.back().axes, scene.cavities.back().open_axis);
+      }
       if (a["core_ramp_s"]) {  // the core rises linearly from 0 over [0, core_ramp_s], then holds
         const double ramp = r.number(a["core_ramp_s"], key + ".core_ramp_s");
         if (!(ramp > 0) || ramp > start) r.fail(a["core_ramp_s"], key + ".core_ramp_s", "must be in (0, start]");
         scene.cavities.back().pressure = TimeFunction::ramp(schedule->core_pressure_pa, ramp);
       }
-    } else if (a["core_ramp_s"]) {
-      r.fail(a["core_ramp_s"], key + ".core_ramp_s", "needs 'core'");
+    } else if (a["core_ramp_s"] || a["core_open_axis"]) {
+      const char* k = a["core_ramp_s"] ? "core_ramp_s" : "core_open_axis";
+      r.fail(a[k], key + "." + k, "needs 'core'");
     }
     if (const auto f = a["feet"]) {
       r.allow(f, key + ".feet", {"foot_a", "foot_b", "mu_active", "mu_inactive"});

@@ -17,6 +17,9 @@
 //       - {name: core, surfaces: [inner], volume_axes: [x, y], pressure: 40e3}
 //         # pressure [Pa]: a number (ramped 0 -> value over the run) or a table
 //         # [[t0, p0], [t1, p1], ...] (piecewise linear, times in s)
+//       - {name: core, surfaces: [core_wall], open_axis: y, pressure: 12e3}
+//         # open_axis: a sleeve open at both ends along that axis (volume axes the
+//         # other two): pressure in the cross-sections only, no end-cap force
 //     gas_cavities:                             # isothermal ideal gas fed through a valve
 //       - {name: core, surfaces: [inner], volume_axes: [x, y, z], symmetry_factor: 1,
 //          temperature: 293.15, initial_gauge_pressure: 0,          # K, Pa
@@ -46,7 +49,7 @@
 //   actuation:                                  # a schedule file shared with `morphfem hw play`
 //     {schedule: schedules/rolling.yaml, start: 1.0,      # gait time 0 at t = start [s]
 //      bladders: {b1: bladder_1_wall, ...},               # channel -> cavity wall surface
-//      core: core_wall, volume_axes: [x, y, z],
+//      core: core_wall, volume_axes: [x, y, z], core_open_axis: y,   # (open sleeve core)
 //      feet: {foot_a: foot_a, foot_b: foot_b, mu_active: 2.0, mu_inactive: 1.0e-4}}
 //     # schedule: a file, or the schedule itself inline (a mapping in the schedule file format)
 //     # or, instead of bladder cavities, the voxel study's growth actuation

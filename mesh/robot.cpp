@@ -212,13 +212,18 @@ void add_split_layer(Assembly& a, double width, double z0, double z1, const std:
 }
 
 // The core gap z in [z0, z1]: solid bonded strips along x = 0 and x = width (edge wide),
-// end seals at y = 0 and y = length (seal wide), and the cavity between them.
+// end seals at y = 0 and y = length (seal wide), and the cavity between them. With
+// seal = 0 the gap is open at both ends (a sleeve): core_wall is then the gap's top,
+// bottom and side faces only, and its volume must be taken over the x and z axes
+// (volume_axes [x, z], exact while the open ends stay in planes y = const).
 void add_core(Assembly& a, double width, double edge, double seal, double z0, double z1) {
   const double l = a.length;
   a.pieces.push_back({axis_box(0, edge, 0, l, z0, z1), "skin"});
   a.pieces.push_back({axis_box(width - edge, width, 0, l, z0, z1), "skin"});
-  a.pieces.push_back({axis_box(edge, width - edge, 0, seal, z0, z1), "skin"});
-  a.pieces.push_back({axis_box(edge, width - edge, l - seal, l, z0, z1), "skin"});
+  if (seal > 0) {
+    a.pieces.push_back({axis_box(edge, width - edge, 0, seal, z0, z1), "skin"});
+    a.pieces.push_back({axis_box(edge, width - edge, l - seal, l, z0, z1), "skin"});
+  }
   a.cavities.push_back({axis_box(edge, width - edge, seal, l - seal, z0, z1), "core_wall"});
 }
 
@@ -238,7 +243,7 @@ CommonRobot common_robot(const ParamSet& params, double width, double length, do
   c.length = length_param(params, "length", length);
   c.core_gap = length_param(params, "core_gap", core_gap);
   c.edge = length_param(params, "edge_width", edge);
-  c.seal = length_param(params, "end_seal", seal);
+  c.seal = params.number_in("end_seal", 0.0, kHuge, seal);  // 0: open ends
   c.bladder_thickness = length_param(params, "bladder_thickness", bladder_thickness);
   c.bladder_width = length_param(params, "bladder_width", bladder_width);
   c.foot_length = length_param(params, "foot_length", foot_length);

@@ -20,7 +20,9 @@
 //   edge_width 0.01 (bonded long-edge strips), end_seal 0.01 (strips closing the gap at
 //   the two ends), bladder_thickness 0.02, bladder_width 0.03 (four columns per face,
 //   evenly spaced from x = 0 to x = width), bladder_start 0.03, bladder_end 0.19 (y),
-//   foot_length 0.03.
+//   foot_length 0.03. end_seal 0 (either preset) leaves the core open at both ends,
+//   like the lattice's layers (bonded only along the long edges) and the physical
+//   sleeve around its inner balloon; its pressure then needs volume_axes [x, z].
 //   Volumes: skin (both layers and the bonding strips), bladder_1 .. bladder_8 (solid).
 //   Surfaces: core_wall (closed inner boundary of the core gap), bottom (every
 //   downward-facing outer face: lower-bladder bottoms at z = 0 and uncovered skin
