@@ -172,10 +172,13 @@ Mesh mesh_assembly(const Assembly& assembly, double mesh_size, int order, const 
       }
     }
     if (!foot) surface_tags[bladder ? "bladder_surface" : "skin_surface"].push_back(tag);
+    // The end faces (normal along y) at y = 0 and y = length, for slices in plane strain.
+    if (s.axis == 1 && s.nodes.hi.y() <= tol) surface_tags["end_a"].push_back(tag);
+    if (s.axis == 1 && s.nodes.lo.y() >= assembly.length - tol) surface_tags["end_b"].push_back(tag);
   }
   std::vector<std::string> surface_order;
   for (const Cavity& c : assembly.cavities) surface_order.push_back(c.surface);
-  for (const char* name : {"bottom", "foot_a", "foot_b", "outer", "skin_surface", "bladder_surface"})
+  for (const char* name : {"bottom", "foot_a", "foot_b", "outer", "skin_surface", "bladder_surface", "end_a", "end_b"})
     surface_order.push_back(name);
   for (const std::string& name : surface_order) add_group(2, surface_tags[name], name);
 

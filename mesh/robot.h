@@ -28,6 +28,8 @@
 //   downward-facing outer face: lower-bladder bottoms at z = 0 and uncovered skin
 //   bottom, feet included), foot_a, foot_b (also in bottom), outer (the rest of the
 //   outer boundary). core_wall, bottom and outer together hold every boundary face once.
+//   end_a, end_b (also in outer): the end faces at y = 0 and y = length (a short slice
+//   with u_y = 0 on both is the mid-length cross-section in plane strain).
 //
 // robot_physical (the physical laminate; defaults in m):
 //   width 0.10 (flat width = half of the 0.20 circumference), length 0.15 (tube axis),

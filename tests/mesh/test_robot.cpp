@@ -121,8 +121,8 @@ void expect_voxel_robot(const Mesh& mesh) {
   std::vector<std::string> volumes = bladder_names("");
   volumes.push_back("skin");
   EXPECT_EQ(sorted(mesh.region_names(3)), sorted(volumes));
-  EXPECT_EQ(sorted(mesh.region_names(2)),
-            sorted({"core_wall", "bottom", "foot_a", "foot_b", "outer", "skin_surface", "bladder_surface"}));
+  EXPECT_EQ(sorted(mesh.region_names(2)), sorted({"core_wall", "bottom", "foot_a", "foot_b", "outer", "skin_surface",
+                                                  "bladder_surface", "end_a", "end_b"}));
 
   // Region volumes: exact for straight-sided tetrahedra filling boxes.
   const double skin = 2 * kW * kL * kT + 2 * kEdge * kL * kGap + 2 * (kW - 2 * kEdge) * kSeal * kGap;
@@ -160,6 +160,10 @@ void expect_voxel_robot(const Mesh& mesh) {
   EXPECT_NEAR(area(mesh, "foot_b"), kW * kFoot, 1e-12);
   EXPECT_NEAR(area(mesh, "bottom"), kW * kL, 1e-12);
   expect_bottom_levels(mesh);
+  // The end faces: the sealed cross-section (two layers, the gap's seal) at y = 0 and y = L.
+  const double end = 2 * kW * kT + kW * kGap;
+  EXPECT_NEAR(area(mesh, "end_a"), end, 1e-12);
+  EXPECT_NEAR(area(mesh, "end_b"), end, 1e-12);
 }
 
 // Bladders 1..4 on top with increasing x, 5..8 below with decreasing x.
@@ -203,7 +207,8 @@ TEST(RobotGeometry, PhysicalPreset) {
   volumes.push_back("fabric");
   EXPECT_EQ(sorted(mesh.region_names(3)), sorted(volumes));
   std::vector<std::string> surfaces = bladder_names("_wall");
-  for (const char* name : {"core_wall", "bottom", "foot_a", "foot_b", "outer", "skin_surface", "bladder_surface"})
+  for (const char* name :
+       {"core_wall", "bottom", "foot_a", "foot_b", "outer", "skin_surface", "bladder_surface", "end_a", "end_b"})
     surfaces.push_back(name);
   EXPECT_EQ(sorted(mesh.region_names(2)), sorted(surfaces));
 
@@ -268,6 +273,20 @@ TEST(RobotGeometry, OverridesAndBadParameters) {
                InputError);
   EXPECT_THROW(build_geometry(robot_params("robot_physical", {{"mesh_size", 0.03}, {"fabric_thickness", 0.003}})),
                InputError);
+}
+
+// end_seal 0: the core is open at both ends. Its wall is the gap's top, bottom and
+// sides only (area exact), the open sleeve's volume over x and z is the gap, and the
+// end faces lack the gap.
+TEST(RobotGeometry, OpenEndedCore) {
+  const Mesh mesh = build_geometry(robot_params("robot_voxel", {{"mesh_size", 0.03}, {"end_seal", 0.0}}));
+  EXPECT_NEAR(area(mesh, "core_wall"), 2 * (kW - 2 * kEdge) * kL + 2 * kGap * kL, 1e-12);
+  const double skin = 2 * kW * kL * kT + 2 * kEdge * kL * kGap;
+  EXPECT_NEAR(region_volume(mesh, "skin"), skin, 1e-10 * skin);
+  EXPECT_NEAR(area(mesh, "end_a"), 2 * kW * kT + 2 * kEdge * kGap, 1e-12);
+  EXPECT_NEAR(area(mesh, "end_b"), 2 * kW * kT + 2 * kEdge * kGap, 1e-12);
+  for (int f : mesh.faces_of("core_wall")) EXPECT_LT(std::abs(face_area_normal(mesh, f).normalized().y()), 1e-12);
+  EXPECT_THROW(build_geometry(robot_params("robot_voxel", {{"mesh_size", 0.03}, {"end_seal", -0.01}})), InputError);
 }
 
 TEST(RobotGeometry, PhysicalPresetP2) {
