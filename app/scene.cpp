@@ -102,6 +102,13 @@ struct Reader {
     }
     return out;
   }
+  // true / false.
+  bool flag(const YAML::Node& node, const std::string& key) const {
+    const std::string v = text(node, key);
+    if (v == "true") return true;
+    if (v == "false") return false;
+    fail(node, key, "expected true or false, got '" + v + "'");
+  }
   // An open sleeve's axis (x, y or z) and the volume axes then implied (the other two),
   // unless volume_axes says otherwise (checked by the cavity term).
   void open_axis(const YAML::Node& c, const std::string& key, std::array<bool, 3>& axes, int& axis) const {
@@ -459,7 +466,7 @@ Scene scene_from_yaml(const YAML::Node& root, const std::string& path) {
     const std::string key = "actuation";
     r.allow(a, key,
             {"schedule", "start", "bladders", "growth", "timing", "core", "core_ramp_s", "volume_axes",
-             "core_open_axis", "feet"});
+             "core_open_axis", "feet", "weightless_inflated"});
     if (!a["schedule"]) r.fail(a, key, "missing key 'schedule' (a schedule file)");
     if (a["schedule"].IsMap()) {  // the schedule written inline, in the schedule file format
       YAML::Emitter text;
@@ -500,6 +507,10 @@ Scene scene_from_yaml(const YAML::Node& root, const std::string& path) {
         scene.growth.emplace_back(r.text(kv.second, key + ".growth." + name),
                                   voxel_bladder_growth(*schedule, channel, start, schedule->core_pressure_pa, voxel));
       }
+    }
+    if (const auto w = a["weightless_inflated"]) {
+      if (!a["growth"]) r.fail(w, key + ".weightless_inflated", "needs growth actuation");
+      scene.weightless_inflated = r.flag(w, key + ".weightless_inflated");
     }
     std::array<bool, 3> axes{true, true, true};
     if (a["volume_axes"]) axes = r.axes(a["volume_axes"], key + ".volume_axes");

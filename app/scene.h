@@ -55,7 +55,8 @@
 //     # or, instead of bladder cavities, the voxel study's growth actuation
 //     # (actuation/voxel_growth.h): channel -> bladder volume region, voxel timing
 //     {schedule: ..., start: 1.5, growth: {b1: bladder_1, ...}, core: core_wall,
-//      core_ramp_s: 1.0, feet: {...}}
+//      core_ramp_s: 1.0, feet: {...}, weightless_inflated: false}
+//     # weightless_inflated: the voxel study's inflated bladder voxels get no gravity
 //     # timing: schedule (columns of column_s) or voxel (the lattice's column
 //     # lengths: actuation phase + settle with every foot active); growth implies voxel.
 //   environment:                                # the study's ground: gravity rotated
@@ -148,6 +149,9 @@ struct Scene {
   std::vector<CalibrationUse> calibrations;
   // Prescribed growth (active strain) of volume regions: stretches (g_x, g_y, g_z)(t).
   std::vector<std::pair<std::string, std::function<Eigen::Vector3d(double)>>> growth;
+  // The lattice's quirk (actuation.weightless_inflated): a growing region carries no
+  // gravity while its thickness stretch g_z > 1 (inflating, inflated or deflating).
+  bool weightless_inflated = false;
   GaitSpec gait;
   SolverOptions solver;
   std::string formulation = "displacement";  // elastic element formulation (fem/elastic.h)

@@ -181,9 +181,17 @@ SimulationResult run_scene(const Scene& scene, MPI_Comm comm, const RunOptions& 
     for (size_t id = 0; id < mesh.regions.size(); ++id) {
       if (mesh.regions[id].dim != 3 || density[id] <= 0) continue;
       const Eigen::Vector3d body = density[id] * scene.gravity;
-      assembler.add_term(std::make_shared<BodyForceTerm>(
-          mesh, partition, rank, mesh.cells_of(mesh.regions[id].name),
-          [body](const Eigen::Vector3d&, double) { return body; }, 2 * mesh.order));
+      std::function<Eigen::Vector3d(double)> stretch;
+      if (scene.weightless_inflated)
+        for (const auto& [region, g] : scene.growth)
+          if (region == mesh.regions[id].name) stretch = g;
+      VectorField field = [body](const Eigen::Vector3d&, double) { return body; };
+      if (stretch)  // the lattice's inflated bladder voxels: no weight while g_z > 1
+        field = [body, stretch](const Eigen::Vector3d&, double t) -> Eigen::Vector3d {
+          return stretch(t).z() > 1.0 + 1e-9 ? Eigen::Vector3d::Zero() : body;
+        };
+      assembler.add_term(std::make_shared<BodyForceTerm>(mesh, partition, rank, mesh.cells_of(mesh.regions[id].name),
+                                                         field, 2 * mesh.order));
     }
   }
   if (scene.body_force) {

@@ -245,3 +245,25 @@ solver: {end_time: 10.4, initial_step: 0.3, max_step: 0.3}
   }
   EXPECT_EQ(checked, 2);
 }
+
+// Open-sleeve and weightless keys: bad values name their key; the open axis sets the
+// volume axes to the other two.
+TEST(Scene, OpenSleeveAndWeightlessKeys) {
+  const std::string cavity =
+      "loads:\n  cavities:\n    - {name: core, surfaces: [zmax], open_axis: AXIS, pressure: 1}\n";
+  std::string e = error_of(std::string(kGood) + replace(cavity, "AXIS", "w"));
+  EXPECT_NE(e.find("loads.cavities.open_axis"), std::string::npos) << e;
+  {
+    TempScene s(std::string(kGood) + replace(cavity, "AXIS", "y"));
+    const Scene scene = read_scene(s.file.string());
+    ASSERT_EQ(scene.cavities.size(), 1u);
+    EXPECT_EQ(scene.cavities[0].open_axis, 1);
+    EXPECT_EQ(scene.cavities[0].axes, (std::array<bool, 3>{true, false, true}));
+  }
+  const std::string schedule = std::string(MORPHFEM_SOURCE_DIR) + "/examples/schedules/rolling.yaml";
+  const std::string actuation = "actuation: {schedule: " + schedule + ", bladders: {b1: zmax}, KEY}\n";
+  e = error_of(std::string(kGood) + replace(actuation, "KEY", "weightless_inflated: true"));
+  EXPECT_NE(e.find("needs growth actuation"), std::string::npos) << e;
+  e = error_of(std::string(kGood) + replace(actuation, "KEY", "core_open_axis: y"));
+  EXPECT_NE(e.find("actuation.core_open_axis"), std::string::npos) << e;
+}
