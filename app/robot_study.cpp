@@ -31,14 +31,14 @@ std::string source_dir() { return MORPHFEM_SOURCE_DIR; }
 
 const char* kRobotUsage =
     "usage: morphfem robot COMMAND [options]\n"
-    "  validate [--fidelity L] [--cases A,B,...] [--out DIR]\n"
+    "  validate [--fidelity L] [--cases A,B,...] [--out DIR] [--set KEY=VALUE ...]\n"
     "        the voxel study's baselines (hand-designed rolling and inching, flat and\n"
     "        15 deg hill, four empty schedules): voxel speed beside the finite-element\n"
     "        speed (voxel-study preset, growth actuation), wall time, dofs, steps\n"
     "  ladder --case NAME [--levels 0,1,2] [--out DIR]\n"
     "        one case on several fidelity levels: speed against wall time, and the\n"
     "        cheapest level within 5 % of the finest\n"
-    "  morph [--scene FILE] [--out DIR]\n"
+    "  morph [--scene FILE] [--out DIR] [--set KEY=VALUE ...]\n"
     "        shape change under core pressure (default examples/voxel/morph.yaml): width /\n"
     "        thickness of the mid-length cross-section against core pressure, table, CSV, PNG\n"
     "  friction-sweep [--fidelity L] [--points all|N] [--out DIR]\n"
@@ -48,6 +48,8 @@ const char* kRobotUsage =
     "        wall time of each hand-designed gait (19.8 s) on one rank, beside the voxel\n"
     "        simulator's 136-145 s on this machine\n"
     "  levels    the fidelity levels\n"
+    "--set KEY=VALUE (repeatable) sets a scene key last, e.g. --set geometry.order=2 or\n"
+    "  --set 'materials.bladder_*.density=15000' (a key ending in '*': every key with that prefix)\n"
     "Cases are spread over the MPI ranks (one rank per case): mpirun -n 2 morphfem robot validate\n";
 
 }  // namespace
@@ -123,9 +125,55 @@ std::vector<RobotCase> voxel_baseline_cases(const std::string& dir) {
   };
 }
 
+namespace {
+
+void set_path(YAML::Node node, const std::vector<std::string>& path, size_t i, const YAML::Node& value,
+              const std::string& where, const std::string& key) {
+  if (!node.IsMap()) throw InputError(where, "--set " + key + ": '" + path[i - 1] + "' is not a mapping");
+  if (!path[i].empty() && path[i].back() == '*') {  // every key starting with the prefix
+    if (i + 1 == path.size()) throw InputError(where, "--set " + key + ": '*' cannot be in the last key");
+    const std::string prefix = path[i].substr(0, path[i].size() - 1);
+    int matched = 0;
+    for (auto kv : node)
+      if (kv.first.as<std::string>().rfind(prefix, 0) == 0) {
+        set_path(kv.second, path, i + 1, value, where, key);
+        ++matched;
+      }
+    if (matched == 0) throw InputError(where, "--set " + key + ": no key matches '" + path[i] + "'");
+    return;
+  }
+  if (i + 1 == path.size()) {
+    node[path[i]] = value;
+    return;
+  }
+  if (!node[path[i]]) throw InputError(where, "--set " + key + ": no key '" + path[i] + "' in the scene");
+  set_path(node[path[i]], path, i + 1, value, where, key);
+}
+
+}  // namespace
+
+void set_scene_key(YAML::Node root, const std::string& assignment, const std::string& where) {
+  const auto eq = assignment.find('=');
+  if (eq == std::string::npos || eq == 0 || eq + 1 == assignment.size())
+    throw InputError(where, "--set '" + assignment + "': expected KEY=VALUE (e.g. geometry.order=2)");
+  const std::string key = assignment.substr(0, eq);
+  std::vector<std::string> path;
+  std::stringstream s(key);
+  for (std::string part; std::getline(s, part, '.');) {
+    if (part.empty()) throw InputError(where, "--set " + key + ": empty key in the path");
+    path.push_back(part);
+  }
+  YAML::Node value;
+  try {
+    value = YAML::Load(assignment.substr(eq + 1));
+  } catch (const YAML::Exception& e) {
+    throw InputError(where, "--set " + key + ": the value is not YAML: " + e.what());
+  }
+  set_path(root, path, 0, value, where, key);
+}
+
 YAML::Node robot_scene_yaml(const RobotCase& c, const RobotFidelity& level, const std::string& output_dir) {
-  if (!std::filesystem::exists(c.template_scene)) throw InputError(c.template_scene, "template scene not found");
-  YAML::Node root = YAML::LoadFile(c.template_scene);
+  YAML::Node root = load_scene_yaml(c.template_scene);
   YAML::Node a = root["actuation"];
   if (!a || !a.IsMap() || !a["growth"])
     throw InputError(c.template_scene, "a robot template needs 'actuation' with 'growth' (the voxel-study preset)");
@@ -146,6 +194,7 @@ YAML::Node robot_scene_yaml(const RobotCase& c, const RobotFidelity& level, cons
     root.remove("output");
   else
     root["output"]["directory"] = output_dir;
+  for (const std::string& assignment : c.overrides) set_scene_key(root, assignment, c.template_scene);
   return root;
 }
 
@@ -236,6 +285,14 @@ std::string option(const std::vector<std::string>& args, const std::string& name
   return fallback;
 }
 
+// Every value of a repeatable option (--set A --set B).
+std::vector<std::string> options(const std::vector<std::string>& args, const std::string& name) {
+  std::vector<std::string> out;
+  for (size_t i = 1; i + 1 < args.size(); i += 2)
+    if (args[i] == name) out.push_back(args[i + 1]);
+  return out;
+}
+
 std::vector<std::string> split(const std::string& list) {
   std::vector<std::string> out;
   std::stringstream s(list);
@@ -283,10 +340,11 @@ Json outcome_json(const RobotCase& c, const RobotFidelity& level, const CaseOutc
 }
 
 int validate(const std::vector<std::string>& args, MPI_Comm comm) {
-  check_options(args, {"--fidelity", "--cases", "--out"});
+  check_options(args, {"--fidelity", "--cases", "--out", "--set"});
   const RobotFidelity& level = find_robot_fidelity(option(args, "--fidelity", "0"));
   const std::string out_dir = option(args, "--out", "results/robot/validate");
-  const auto all_cases = voxel_baseline_cases(source_dir());
+  auto all_cases = voxel_baseline_cases(source_dir());
+  for (auto& c : all_cases) c.overrides = options(args, "--set");
   std::vector<std::pair<RobotCase, RobotFidelity>> jobs;
   const std::string wanted = option(args, "--cases", "");
   if (wanted.empty())
@@ -477,9 +535,11 @@ int benchmark(const std::vector<std::string>& args, MPI_Comm comm) {
 }
 
 int morph(const std::vector<std::string>& args, MPI_Comm comm) {
-  check_options(args, {"--scene", "--out"});
+  check_options(args, {"--scene", "--out", "--set"});
   const std::string path = option(args, "--scene", source_dir() + "/examples/voxel/morph.yaml");
-  Scene scene = read_scene(path);
+  YAML::Node doc = load_scene_yaml(path);
+  for (const std::string& assignment : options(args, "--set")) set_scene_key(doc, assignment, path);
+  Scene scene = scene_from_yaml(doc, path);
   if (scene.cavities.empty()) throw InputError(path, "morph needs a pressurised core (loads.cavities)");
   const std::string out_dir =
       option(args, "--out", scene.output_dir.empty() ? "results/robot/morph" : scene.output_dir);

@@ -13,7 +13,8 @@
 //   environment          slope_deg; the heading is the schedule's orientation;
 //   solver.end_time      start + the gait's duration on the voxel timing;
 //   geometry.mesh_size, geometry.order, solver.max_step   from the fidelity level;
-//   output.directory     the case's result folder (or none).
+//   output.directory     the case's result folder (or none);
+//   then the case's overrides (`--set KEY=VALUE` on the command line).
 // The speed is the scene's gait measurement: displacement of the mean node
 // position along the heading from start to the end of the gait, divided by the
 // body length (0.22 m) and the schedule's nominal duration (16 columns), as the
@@ -51,7 +52,14 @@ struct RobotCase {
   // Foot friction (active / inactive); NaN keeps the template's.
   double mu_foot_active = std::numeric_limits<double>::quiet_NaN();
   double mu_foot_inactive = std::numeric_limits<double>::quiet_NaN();
+  // Scene keys set last, "a.b.c=VALUE" (see set_scene_key), e.g. for a diagnostic run.
+  std::vector<std::string> overrides;
 };
+
+// Sets one key of a scene document from "a.b.c=VALUE" (VALUE in YAML; a path segment
+// ending in '*' means every key of that mapping with that prefix, "*" every key). The mappings on the path must exist;
+// the last key may be new. Throws InputError naming `where` and the path.
+void set_scene_key(YAML::Node root, const std::string& assignment, const std::string& where);
 
 // The eight cases of baselines.txt: the hand-designed rolling (0 deg, 12 kPa) and
 // inching (90 deg, 0 kPa) gaits on flat ground and on the 15 deg hill, and the four

@@ -160,17 +160,17 @@ struct Reader {
 
 }  // namespace
 
-Scene read_scene(const std::string& path) {
+YAML::Node load_scene_yaml(const std::string& path) {
   if (!std::filesystem::exists(path)) throw InputError(path, "scene file not found");
-  YAML::Node root;
   try {
-    root = YAML::LoadFile(path);
+    return YAML::LoadFile(path);
   } catch (const YAML::ParserException& e) {
     throw InputError(path + ":" + std::to_string(e.mark.line + 1) + ":" + std::to_string(e.mark.column + 1),
                      "YAML syntax error: " + e.msg);
   }
-  return scene_from_yaml(root, path);
 }
+
+Scene read_scene(const std::string& path) { return scene_from_yaml(load_scene_yaml(path), path); }
 
 Scene scene_from_yaml(const YAML::Node& root, const std::string& path) {
   Scene scene;

@@ -163,6 +163,8 @@ struct Scene {
 // Reads and checks a scene file. Throws InputError("file:line:col", what) on the
 // first problem; nothing is created on disk.
 Scene read_scene(const std::string& path);
+// The scene file's document (InputError if missing or not YAML, with the line).
+YAML::Node load_scene_yaml(const std::string& path);
 // The same from a parsed document (e.g. a template with keys overridden in code);
 // `path` names it in messages and anchors relative file names.
 Scene scene_from_yaml(const YAML::Node& root, const std::string& path);

@@ -63,6 +63,38 @@ TEST(RobotStudy, CaseSetsScheduleSlopeHeadingAndFidelityInTheTemplate) {
   EXPECT_THROW(find_robot_fidelity("9"), InputError);
 }
 
+// --set: keys set last, '*' over a mapping's keys, a new last key; bad paths and
+// assignments are refused with the path named.
+TEST(RobotStudy, OverridesSetSceneKeysLast) {
+  RobotCase c = baseline("roll_flat");
+  c.overrides = {"materials.bladder_*.density=15000", "actuation.weightless_inflated=true", "geometry.order=2"};
+  const YAML::Node doc = robot_scene_yaml(c, find_robot_fidelity("0"), "");
+  EXPECT_EQ(doc["geometry"]["order"].as<int>(), 2);  // after the fidelity level's order 1
+  for (const auto& kv : doc["materials"])
+    EXPECT_EQ(kv.second["density"].as<double>(), kv.first.as<std::string>() == "skin" ? 3000 : 15000) << kv.first;
+  const Scene scene = scene_from_yaml(doc, c.template_scene);
+  EXPECT_TRUE(scene.weightless_inflated);
+
+  YAML::Node root = YAML::Load("{a: {b: 1}}");
+  auto error = [&](const std::string& assignment) {
+    try {
+      set_scene_key(root, assignment, "scene.yaml");
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_NE(error("a.b").find("expected KEY=VALUE"), std::string::npos);
+  EXPECT_NE(error("x.y=1").find("no key 'x'"), std::string::npos);
+  EXPECT_NE(error("a.b.c=1").find("'b' is not a mapping"), std::string::npos);
+  EXPECT_NE(error("a..b=1").find("empty key"), std::string::npos);
+  EXPECT_NE(error("a.*=1").find("'*' cannot be in the last key"), std::string::npos);
+  EXPECT_NE(error("q*.b=1").find("no key matches 'q*'"), std::string::npos);
+  EXPECT_NE(error("a.c=[1, 2").find("not YAML"), std::string::npos);
+  EXPECT_EQ(error("a.c=[1, 2]"), "");
+  EXPECT_EQ(root["a"]["c"][1].as<int>(), 2);
+}
+
 TEST(RobotStudy, CustomFidelityLevelsParseAndBadOnesAreRefused) {
   const RobotFidelity& l = find_robot_fidelity("0.01:2:0.1");
   EXPECT_DOUBLE_EQ(l.mesh_size, 0.01);
