@@ -31,6 +31,40 @@
 
 namespace morphfem {
 
+NodeBox node_box(int dim, int tag) {
+  std::vector<std::size_t> tags;
+  std::vector<double> coords, parametric;
+  gmsh::model::mesh::getNodes(tags, coords, parametric, dim, tag, true, false);
+  NodeBox box;
+  for (std::size_t k = 0; k < tags.size(); ++k) {
+    const Eigen::Vector3d x(coords[3 * k], coords[3 * k + 1], coords[3 * k + 2]);
+    box.min = box.min.cwiseMin(x);
+    box.max = box.max.cwiseMax(x);
+  }
+  return box;
+}
+
+void add_physical_groups(const std::vector<SurfaceRule>& rules) {
+  gmsh::vectorpair volumes, surfaces;
+  gmsh::model::getEntities(volumes, 3);
+  gmsh::model::getEntities(surfaces, 2);
+  std::vector<int> volume_tags;
+  for (const auto& [dim, tag] : volumes) volume_tags.push_back(tag);
+  gmsh::model::setPhysicalName(3, gmsh::model::addPhysicalGroup(3, volume_tags), "body");
+
+  std::vector<std::vector<int>> members(rules.size());
+  for (const auto& [dim, tag] : surfaces) {
+    const NodeBox box = node_box(dim, tag);
+    auto rule = std::find_if(rules.begin(), rules.end(), [&](const SurfaceRule& r) { return r.matches(box); });
+    if (rule == rules.end()) throw std::logic_error("geometry: a boundary surface matches no naming rule");
+    members[rule - rules.begin()].push_back(tag);
+  }
+  for (std::size_t r = 0; r < rules.size(); ++r) {
+    if (members[r].empty()) throw std::logic_error("geometry: no boundary surface named " + rules[r].name);
+    gmsh::model::setPhysicalName(2, gmsh::model::addPhysicalGroup(2, members[r]), rules[r].name);
+  }
+}
+
 namespace {
 
 constexpr double kHuge = std::numeric_limits<double>::max();
@@ -57,62 +91,14 @@ int divisions(double length, double mesh_size) {
   return std::max(1, static_cast<int>(std::lround(length / mesh_size)));
 }
 
-// Axis-aligned bounding box of the mesh nodes of one entity (tight, unlike CAD boxes).
-struct Box {
-  Eigen::Vector3d min = Eigen::Vector3d::Constant(kHuge);
-  Eigen::Vector3d max = Eigen::Vector3d::Constant(-kHuge);
-};
-
-Box node_box(int dim, int tag) {
-  std::vector<std::size_t> tags;
-  std::vector<double> coords, parametric;
-  gmsh::model::mesh::getNodes(tags, coords, parametric, dim, tag, true, false);
-  Box box;
-  for (std::size_t k = 0; k < tags.size(); ++k) {
-    const Eigen::Vector3d x(coords[3 * k], coords[3 * k + 1], coords[3 * k + 2]);
-    box.min = box.min.cwiseMin(x);
-    box.max = box.max.cwiseMax(x);
-  }
-  return box;
-}
-
-// A named surface and the test its entities' node boxes pass; the first rule that
-// matches a surface names it.
-struct SurfaceRule {
-  std::string name;
-  std::function<bool(const Box&)> matches;
-};
-
-// Physical groups: all volumes as "body", each surface entity under its rule's name.
-void add_physical_groups(const std::vector<SurfaceRule>& rules) {
-  gmsh::vectorpair volumes, surfaces;
-  gmsh::model::getEntities(volumes, 3);
-  gmsh::model::getEntities(surfaces, 2);
-  std::vector<int> volume_tags;
-  for (const auto& [dim, tag] : volumes) volume_tags.push_back(tag);
-  gmsh::model::setPhysicalName(3, gmsh::model::addPhysicalGroup(3, volume_tags), "body");
-
-  std::vector<std::vector<int>> members(rules.size());
-  for (const auto& [dim, tag] : surfaces) {
-    const Box box = node_box(dim, tag);
-    auto rule = std::find_if(rules.begin(), rules.end(), [&](const SurfaceRule& r) { return r.matches(box); });
-    if (rule == rules.end()) throw std::logic_error("geometry: a boundary surface matches no naming rule");
-    members[rule - rules.begin()].push_back(tag);
-  }
-  for (std::size_t r = 0; r < rules.size(); ++r) {
-    if (members[r].empty()) throw std::logic_error("geometry: no boundary surface named " + rules[r].name);
-    gmsh::model::setPhysicalName(2, gmsh::model::addPhysicalGroup(2, members[r]), rules[r].name);
-  }
-}
-
 // Rules naming the planes x = 0, x = lx, y = 0, y = ly, z = 0, z = lz of a box.
 std::vector<SurfaceRule> box_face_rules(const Eigen::Vector3d& lengths, const std::array<std::string, 6>& names) {
   const double tol = 1e-6 * lengths.maxCoeff();
   std::vector<SurfaceRule> rules;
   for (int axis = 0; axis < 3; ++axis) {
     const double l = lengths(axis);
-    rules.push_back({names[2 * axis], [=](const Box& b) { return b.max(axis) < tol; }});
-    rules.push_back({names[2 * axis + 1], [=](const Box& b) { return b.min(axis) > l - tol; }});
+    rules.push_back({names[2 * axis], [=](const NodeBox& b) { return b.max(axis) < tol; }});
+    rules.push_back({names[2 * axis + 1], [=](const NodeBox& b) { return b.min(axis) > l - tol; }});
   }
   return rules;
 }
@@ -267,12 +253,12 @@ Mesh build_thick_cylinder(const ParamSet& params) {
   generate_tet_mesh(common.mesh_size, common.order);
 
   const double tol = 1e-6 * r_out, r_mid = 0.5 * (r_in + r_out);
-  add_physical_groups({{"zmin", [=](const Box& b) { return b.max.z() < tol; }},
-                       {"zmax", [=](const Box& b) { return b.min.z() > height - tol; }},
-                       {"sym_x", [=](const Box& b) { return b.max.x() < tol; }},
-                       {"sym_y", [=](const Box& b) { return b.max.y() < tol; }},
-                       {"inner", [=](const Box& b) { return std::max(b.max.x(), b.max.y()) < r_mid; }},
-                       {"outer", [=](const Box& b) { return true; }}});
+  add_physical_groups({{"zmin", [=](const NodeBox& b) { return b.max.z() < tol; }},
+                       {"zmax", [=](const NodeBox& b) { return b.min.z() > height - tol; }},
+                       {"sym_x", [=](const NodeBox& b) { return b.max.x() < tol; }},
+                       {"sym_y", [=](const NodeBox& b) { return b.max.y() < tol; }},
+                       {"inner", [=](const NodeBox& b) { return std::max(b.max.x(), b.max.y()) < r_mid; }},
+                       {"outer", [=](const NodeBox& b) { return true; }}});
   return mesh_from_current_gmsh_model(params.context().empty() ? "geometry thick_cylinder" : params.context());
 }
 
@@ -294,11 +280,11 @@ Mesh build_spherical_shell(const ParamSet& params) {
   generate_tet_mesh(common.mesh_size, common.order);
 
   const double tol = 1e-6 * r_out, r_mid = 0.5 * (r_in + r_out);
-  add_physical_groups({{"sym_x", [=](const Box& b) { return b.max.x() < tol; }},
-                       {"sym_y", [=](const Box& b) { return b.max.y() < tol; }},
-                       {"sym_z", [=](const Box& b) { return b.max.z() < tol; }},
-                       {"inner", [=](const Box& b) { return b.max.maxCoeff() < r_mid; }},
-                       {"outer", [=](const Box& b) { return true; }}});
+  add_physical_groups({{"sym_x", [=](const NodeBox& b) { return b.max.x() < tol; }},
+                       {"sym_y", [=](const NodeBox& b) { return b.max.y() < tol; }},
+                       {"sym_z", [=](const NodeBox& b) { return b.max.z() < tol; }},
+                       {"inner", [=](const NodeBox& b) { return b.max.maxCoeff() < r_mid; }},
+                       {"outer", [=](const NodeBox& b) { return true; }}});
   return mesh_from_current_gmsh_model(params.context().empty() ? "geometry spherical_shell" : params.context());
 }
 
@@ -327,12 +313,12 @@ Mesh build_cook_membrane(const ParamSet& params) {
   generate_tet_mesh(common.mesh_size, common.order);
 
   const double tol = 1e-6 * 60 * scale;
-  add_physical_groups({{"zmin", [=](const Box& bx) { return bx.max.z() < tol; }},
-                       {"zmax", [=](const Box& bx) { return bx.min.z() > thickness - tol; }},
-                       {"left", [=](const Box& bx) { return bx.max.x() < tol; }},
-                       {"right", [=](const Box& bx) { return bx.min.x() > 48 * scale - tol; }},
-                       {"bottom", [=](const Box& bx) { return bx.min.y() < tol; }},
-                       {"top", [=](const Box& bx) { return bx.max.y() > 60 * scale - tol; }}});
+  add_physical_groups({{"zmin", [=](const NodeBox& bx) { return bx.max.z() < tol; }},
+                       {"zmax", [=](const NodeBox& bx) { return bx.min.z() > thickness - tol; }},
+                       {"left", [=](const NodeBox& bx) { return bx.max.x() < tol; }},
+                       {"right", [=](const NodeBox& bx) { return bx.min.x() > 48 * scale - tol; }},
+                       {"bottom", [=](const NodeBox& bx) { return bx.min.y() < tol; }},
+                       {"top", [=](const NodeBox& bx) { return bx.max.y() > 60 * scale - tol; }}});
   return mesh_from_current_gmsh_model(params.context().empty() ? "geometry cook_membrane" : params.context());
 }
 

@@ -3,9 +3,12 @@
 // registered by name in one place (geometry.cpp) and read their parameters from
 // a ParamSet, so scenes pick a geometry with `geometry: {type: NAME, ...}`.
 #pragma once
+#include <Eigen/Dense>
 #include <functional>
+#include <limits>
 #include <map>
 #include <string>
+#include <vector>
 
 #include "core/params.h"
 #include "mesh/mesh.h"
@@ -41,6 +44,23 @@ void write_msh(const Mesh& mesh, const std::string& path);
 // Lower level, shared by the builders and read_msh.
 // Initializes the gmsh API once per process (quiet, single-threaded); cheap to repeat.
 void initialize_gmsh();
+// Tight axis-aligned bounding box of the mesh nodes of one gmsh entity (dim, tag),
+// unlike gmsh's CAD boxes.
+struct NodeBox {
+  Eigen::Vector3d min = Eigen::Vector3d::Constant(std::numeric_limits<double>::max());
+  Eigen::Vector3d max = Eigen::Vector3d::Constant(-std::numeric_limits<double>::max());
+};
+NodeBox node_box(int dim, int tag);
+// A named surface and the test its entities' node boxes pass.
+struct SurfaceRule {
+  std::string name;
+  std::function<bool(const NodeBox&)> matches;
+};
+// Physical groups of the meshed current model: every volume as "body", each surface
+// entity under the name of the first rule it matches (std::logic_error if it matches
+// none, or a rule names no entity).
+void add_physical_groups(const std::vector<SurfaceRule>& rules);
+
 // Meshes the synchronized current model in 3-D: target size mesh_size [m] at every
 // CAD point (a background size field can only refine below it), element order 1 or 2
 // with curved mid-nodes, deterministic single-threaded Delaunay.

@@ -61,7 +61,7 @@ struct Assembly {
 struct SurfaceSample {
   Vec3 point = Vec3::Zero();
   int axis = 2;  // the coordinate axis the (planar, axis-aligned) surface is normal to
-  AxisBox nodes{Vec3::Constant(kHuge), Vec3::Constant(-kHuge)};
+  AxisBox nodes;
 };
 
 Vec3 node_coordinates(std::size_t tag) {
@@ -81,14 +81,8 @@ SurfaceSample sample_surface(int tag) {
   s.point = (a + b + c) / 3.0;
   (b - a).cross(c - a).cwiseAbs().maxCoeff(&s.axis);
 
-  std::vector<std::size_t> tags;
-  std::vector<double> coords, parametric;
-  gmsh::model::mesh::getNodes(tags, coords, parametric, 2, tag, true, false);
-  for (std::size_t k = 0; k < tags.size(); ++k) {
-    const Vec3 x(coords[3 * k], coords[3 * k + 1], coords[3 * k + 2]);
-    s.nodes.lo = s.nodes.lo.cwiseMin(x);
-    s.nodes.hi = s.nodes.hi.cwiseMax(x);
-  }
+  const NodeBox box = node_box(2, tag);
+  s.nodes = {box.min, box.max};
   return s;
 }
 

@@ -19,50 +19,6 @@ namespace {
 
 constexpr double kHuge = std::numeric_limits<double>::max();
 
-// Bounding box of the mesh nodes of one surface entity (tight, unlike CAD boxes).
-struct NodeBox {
-  Eigen::Vector3d min = Eigen::Vector3d::Constant(kHuge);
-  Eigen::Vector3d max = Eigen::Vector3d::Constant(-kHuge);
-};
-
-NodeBox surface_node_box(int tag) {
-  std::vector<std::size_t> tags;
-  std::vector<double> coords, parametric;
-  gmsh::model::mesh::getNodes(tags, coords, parametric, 2, tag, true, false);
-  NodeBox box;
-  for (std::size_t k = 0; k < tags.size(); ++k) {
-    const Eigen::Vector3d x(coords[3 * k], coords[3 * k + 1], coords[3 * k + 2]);
-    box.min = box.min.cwiseMin(x);
-    box.max = box.max.cwiseMax(x);
-  }
-  return box;
-}
-
-// Physical groups: every volume as "body"; each surface entity named by the first
-// rule its node box passes (rules in order, the last one should accept anything).
-using SurfaceNamer = std::vector<std::pair<std::string, std::function<bool(const NodeBox&)>>>;
-
-void name_regions(const SurfaceNamer& rules) {
-  gmsh::vectorpair volumes, surfaces;
-  gmsh::model::getEntities(volumes, 3);
-  gmsh::model::getEntities(surfaces, 2);
-  std::vector<int> volume_tags;
-  for (const auto& [dim, tag] : volumes) volume_tags.push_back(tag);
-  gmsh::model::setPhysicalName(3, gmsh::model::addPhysicalGroup(3, volume_tags), "body");
-  std::vector<std::vector<int>> members(rules.size());
-  for (const auto& [dim, tag] : surfaces) {
-    const NodeBox box = surface_node_box(tag);
-    std::size_t r = 0;
-    while (r < rules.size() && !rules[r].second(box)) ++r;
-    if (r == rules.size()) throw std::logic_error("solid shape: a boundary surface matches no naming rule");
-    members[r].push_back(tag);
-  }
-  for (std::size_t r = 0; r < rules.size(); ++r) {
-    if (members[r].empty()) throw std::logic_error("solid shape: no boundary surface named " + rules[r].first);
-    gmsh::model::setPhysicalName(2, gmsh::model::addPhysicalGroup(2, members[r]), rules[r].first);
-  }
-}
-
 std::string source_of(const ParamSet& params, const std::string& type) {
   return params.context().empty() ? "geometry " + type : params.context();
 }
@@ -107,14 +63,14 @@ Mesh build_hemisphere(const ParamSet& params) {
   generate_tet_mesh(mesh_size, order);  // a background size field can only refine below mesh_size
 
   const double tol = 1e-6 * radius;
-  SurfaceNamer rules;
+  std::vector<SurfaceRule> rules;
   if (quarter) {
     rules.push_back({"sym_x", [=](const NodeBox& b) { return b.max.x() < tol; }});
     rules.push_back({"sym_y", [=](const NodeBox& b) { return b.max.y() < tol; }});
   }
   rules.push_back({"flat", [=](const NodeBox& b) { return b.min.z() > -tol; }});
   rules.push_back({"sphere", [](const NodeBox&) { return true; }});
-  name_regions(rules);
+  add_physical_groups(rules);
   return mesh_from_current_gmsh_model(source_of(params, "hemisphere"));
 }
 
@@ -139,12 +95,12 @@ Mesh build_solid_cylinder(const ParamSet& params) {
   generate_tet_mesh(mesh_size, order);  // a background size field can only refine below mesh_size
 
   const double tol = 1e-6 * std::max(radius, length), r_mid = 0.5 * (radius + inner_radius);
-  SurfaceNamer rules{{"ymin", [=](const NodeBox& b) { return b.max.y() < tol; }},
-                     {"ymax", [=](const NodeBox& b) { return b.min.y() > length - tol; }}};
+  std::vector<SurfaceRule> rules{{"ymin", [=](const NodeBox& b) { return b.max.y() < tol; }},
+                                 {"ymax", [=](const NodeBox& b) { return b.min.y() > length - tol; }}};
   if (inner_radius > 0)
     rules.push_back({"inner", [=](const NodeBox& b) { return std::max(b.max.x(), b.max.z()) < r_mid; }});
   rules.push_back({"outer", [](const NodeBox&) { return true; }});
-  name_regions(rules);
+  add_physical_groups(rules);
   return mesh_from_current_gmsh_model(source_of(params, "solid_cylinder"));
 }
 
