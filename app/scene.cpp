@@ -109,16 +109,19 @@ struct Reader {
     if (v == "false") return false;
     fail(node, key, "expected true or false, got '" + v + "'");
   }
-  // An open sleeve's axis (x, y or z) and the volume axes then implied (the other two),
-  // unless volume_axes says otherwise (checked by the cavity term).
+  // An open sleeve's axis (x, y or z) and the volume axes it implies (the other two).
   void open_axis(const YAML::Node& c, const std::string& key, std::array<bool, 3>& axes, int& axis) const {
     if (!c["open_axis"]) return;
     const std::string name = text(c["open_axis"], key + ".open_axis");
     if (name != "x" && name != "y" && name != "z")
       fail(c["open_axis"], key + ".open_axis", "unknown axis '" + name + "' (allowed: x, y, z)");
     axis = name[0] - 'x';
-    if (!c["volume_axes"])
-      for (int i = 0; i < 3; ++i) axes[i] = i != axis;
+    std::array<bool, 3> others{};
+    for (int i = 0; i < 3; ++i) others[i] = i != axis;
+    if (c["volume_axes"] && axes != others)
+      fail(c["volume_axes"], key + ".volume_axes",
+           "an open sleeve's volume axes are the two other than open_axis (leave volume_axes out)");
+    axes = others;
   }
   // A map of scalars and numeric lists -> ParamSet (each value remembers its line).
   ParamSet params(const YAML::Node& map, const std::string& context) const {

@@ -260,6 +260,8 @@ TEST(Scene, OpenSleeveAndWeightlessKeys) {
     EXPECT_EQ(scene.cavities[0].open_axis, 1);
     EXPECT_EQ(scene.cavities[0].axes, (std::array<bool, 3>{true, false, true}));
   }
+  e = error_of(std::string(kGood) + replace(cavity, "AXIS", "y, volume_axes: [x, y]"));
+  EXPECT_NE(e.find("loads.cavities.volume_axes"), std::string::npos) << e;
   const std::string schedule = std::string(MORPHFEM_SOURCE_DIR) + "/examples/schedules/rolling.yaml";
   const std::string actuation = "actuation: {schedule: " + schedule + ", bladders: {b1: zmax}, KEY}\n";
   e = error_of(std::string(kGood) + replace(actuation, "KEY", "weightless_inflated: true"));
