@@ -8,6 +8,13 @@
 // x = 7 (uniaxial stretch ~ 3, i.e. 200 % strain, the range the silicone fits cover).
 // E.g. the published Dragon Skin 10 fit (c1 0.022, c2 3.0e-3, c3 -1.1e-4 MPa) stays
 // stable up to x ~ 21 (uniaxial stretch ~ 4.9).
+// Beyond the fitted range the cubic is not data, and with c3 < 0 it runs to -inf (a
+// Newton iterate that overstretches one element then finds ever lower energy and
+// diverges). So for c3 < 0 the law is continued linearly in x beyond the inflection
+// x_c = max(0, -c2 / (3 c3)), where dW/dx peaks and d2W/dx2 = 0: the continuation
+// W(x_c) + W1(x_c) (x - x_c) is C2 there, neo-Hookean-like (W1 = its maximum > 0) and
+// bounded below. x_c = 9.1 (DS10) and 8.4 (DS30), past the fits' x < 7.
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <sstream>
@@ -20,22 +27,29 @@ namespace {
 
 class Yeoh final : public InvariantMaterial {
  public:
-  Yeoh(double c1, double c2, double c3, double kappa) : InvariantMaterial(kappa, false), c1_(c1), c2_(c2), c3_(c3) {}
+  Yeoh(double c1, double c2, double c3, double kappa)
+      : InvariantMaterial(kappa, false),
+        c1_(c1),
+        c2_(c2),
+        c3_(c3),
+        x_linear_(c3 < 0.0 ? std::max(0.0, -c2 / (3.0 * c3)) : INFINITY) {}
   std::string name() const override { return "yeoh"; }
   double shear_modulus() const override { return 2.0 * c1_; }
 
  protected:
   IsochoricDerivatives isochoric(double Ibar1, double, bool) const override {
     const double x = Ibar1 - 3.0;
+    const double xc = std::min(x, x_linear_);  // the cubic up to x_linear_, then its tangent line
     IsochoricDerivatives d;
-    d.W = x * (c1_ + x * (c2_ + x * c3_));
-    d.W1 = c1_ + x * (2.0 * c2_ + 3.0 * x * c3_);
-    d.W11 = 2.0 * c2_ + 6.0 * c3_ * x;
+    d.W1 = c1_ + xc * (2.0 * c2_ + 3.0 * xc * c3_);
+    d.W = xc * (c1_ + xc * (c2_ + xc * c3_)) + d.W1 * (x - xc);
+    d.W11 = x < x_linear_ ? 2.0 * c2_ + 6.0 * c3_ * x : 0.0;
     return d;
   }
 
  private:
   double c1_, c2_, c3_;  // [Pa]
+  double x_linear_;      // x beyond which W is linear in x (c3 < 0), else +inf
 };
 
 }  // namespace

@@ -322,4 +322,41 @@ TEST(MaterialLaw, RejectsBadParameters) {
 }
 
 }  // namespace
+
+// Yeoh with c3 < 0 beyond its inflection x_c = -c2 / (3 c3) (uniaxial stretch ~ 3.5 for
+// these Dragon Skin 10 coefficients): continued linearly in Ibar1 - 3, so the uniaxial
+// stress keeps rising (the bare cubic turns it negative near stretch 4.9, and the
+// energy to -inf), and stress and tangent stay consistent across x_c.
+TEST(MaterialLaw, YeohWithNegativeC3StaysStableBeyondItsInflection) {
+  const double c1 = 21589.8, c2 = 3044.3, c3 = -111.6, kappa = 2e6 * c1;
+  const auto m = make_material(make_params("yeoh", {{"c1", {c1}}, {"c2", {c2}}, {"c3", {c3}}, {"kappa", {kappa}}}));
+  double previous = 0.0;
+  for (double l = 1.1; l <= 8.0; l += 0.1) {
+    const double P = uniaxial_P11(*m, l);
+    EXPECT_GT(P, previous) << "stretch " << l;
+    previous = P;
+  }
+  // Below x_c the cubic itself (the fit's closed form).
+  EXPECT_NEAR(uniaxial_P11(*m, 2.5), uniaxial_stress_yeoh(2.5, c1, c2, c3), 1e-5 * uniaxial_P11(*m, 2.5));
+  // Stress and tangent against finite differences just below, at and beyond x_c
+  // (isochoric stretch diag(l, 1/sqrt l, 1/sqrt l): Ibar1 - 3 = l^2 + 2/l - 3).
+  const double xc = -c2 / (3 * c3);
+  for (double x : {xc - 0.5, xc, xc + 0.5, 40.0}) {
+    double l = 2.0;  // solve l^2 + 2/l - 3 = x (Newton)
+    for (int it = 0; it < 50; ++it) l -= (l * l + 2 / l - 3 - x) / (2 * l - 2 / (l * l));
+    Mat3 F = Mat3::Zero();
+    F(0, 0) = l;
+    F(1, 1) = F(2, 2) = 1 / std::sqrt(l);
+    F(0, 1) = 0.05;
+    double W;
+    Mat3 P;
+    Tangent A;
+    m->evaluate(F, W, P, &A);
+    EXPECT_TRUE(std::isfinite(W) && W > 0) << "x " << x;
+    EXPECT_LE((flatten(P) - fd_stress(*m, F, 1e-6)).cwiseAbs().maxCoeff(), 1e-6 * (P.cwiseAbs().maxCoeff() + c1))
+        << "x " << x;
+    EXPECT_LE((A - fd_tangent(*m, F, 1e-6)).cwiseAbs().maxCoeff(), 1e-5 * A.cwiseAbs().maxCoeff()) << "x " << x;
+  }
+}
+
 }  // namespace morphfem
