@@ -129,7 +129,9 @@ namespace {
 
 void set_path(YAML::Node node, const std::vector<std::string>& path, size_t i, const YAML::Node& value,
               const std::string& where, const std::string& key) {
-  if (!node.IsMap()) throw InputError(where, "--set " + key + ": '" + path[i - 1] + "' is not a mapping");
+  if (!node.IsMap())
+    throw InputError(where,
+                     "--set " + key + ": " + (i == 0 ? "the scene" : "'" + path[i - 1] + "'") + " is not a mapping");
   if (!path[i].empty() && path[i].back() == '*') {  // every key starting with the prefix
     if (i + 1 == path.size()) throw InputError(where, "--set " + key + ": '*' cannot be in the last key");
     const std::string prefix = path[i].substr(0, path[i].size() - 1);
@@ -373,7 +375,9 @@ int validate(const std::vector<std::string>& args, MPI_Comm comm) {
               level.max_step, table.c_str());
   std::filesystem::create_directories(out_dir);
   Json summary;
-  summary.add("fidelity", level.name).add("cases", rows);
+  std::string overrides;  // the --set assignments, as given
+  for (const auto& assignment : options(args, "--set")) overrides += (overrides.empty() ? "" : "; ") + assignment;
+  summary.add("fidelity", level.name).add("overrides", overrides).add("cases", rows);
   write_file_atomic(out_dir + "/validation.json", summary.str(true) + "\n");
   write_file_atomic(out_dir + "/validation.txt", table);
   std::printf("results: %s/validation.json, per case %s/CASE_L%s/\n", out_dir.c_str(), out_dir.c_str(),
