@@ -53,7 +53,7 @@ struct RobotCase {
   double mu_foot_active = std::numeric_limits<double>::quiet_NaN();
   double mu_foot_inactive = std::numeric_limits<double>::quiet_NaN();
   // Scene keys set last, "a.b.c=VALUE" (see set_scene_key), e.g. for a diagnostic run.
-  std::vector<std::string> overrides;
+  std::vector<std::string> overrides = {};
 };
 
 // Sets one key of a scene document from "a.b.c=VALUE" (VALUE in YAML; a path segment
