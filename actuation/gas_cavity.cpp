@@ -260,7 +260,7 @@ void GasCavityTerm::end_step(Assembler& assembler, Vec u1, double t1) {
 
 void GasCavityTerm::begin_valve_step(double t0, double t1) {
   const double dt = t1 - t0;
-  const double C = spec_.conductance(t1);
+  const double C = spec_.conductance_at(t1);
   const double supply = spec_.atmospheric_pressure + spec_.supply_gauge_pressure(t1);  // absolute [Pa]
   if (!(C >= 0)) throw std::invalid_argument("gas cavity '" + wall_.name + "': conductance must be >= 0");
   if (!(supply >= 0))

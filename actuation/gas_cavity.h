@@ -108,7 +108,10 @@ class CavityVolumeTerm : public EnergyTerm {
 // Valve: gas flows from a supply at gauge pressure p_s(t) (> 0: line pressure,
 // < 0: vacuum source; absolute p_atm + p_s >= 0) through a linear conductance C(t):
 //   dn/dt = C (p_atm + p_s - p)      C [mol/(s Pa)]
-// (a laminar / linearised-orifice law; C = 0 seals the cavity). Integrated with
+// (a laminar / linearised-orifice law; C = 0 seals the cavity). The line and the
+// vacuum pump reach the cavity through different paths (regulator, tubing, pump):
+// while the source is a vacuum (p_s(t1) < 0) the conductance is C_vac(t) if given,
+// else C(t). Integrated with
 // backward Euler over each step t0 -> t1 (dt = t1 - t0), p_s and C at t1:
 //   n1 = n0 + dt C (p_atm + p_s - n1 R T / V1)
 //   =>  n1 = m V1 / (V1 + V_r),   m = n0 + dt C (p_atm + p_s),   V_r = dt C R T,
@@ -133,6 +136,12 @@ struct GasCavitySpec {
   double initial_gauge_pressure = 0.0;
   TimeFunction supply_gauge_pressure = TimeFunction::constant(0.0);  // p_s(t) [Pa]
   TimeFunction conductance = TimeFunction::constant(0.0);            // C(t) [mol/(s Pa)]
+  bool has_vacuum_conductance = false;                               // false: C(t) for vacuum too
+  TimeFunction vacuum_conductance = TimeFunction::constant(0.0);     // C_vac(t) [mol/(s Pa)]
+  // The conductance of the step ending at t1 (C or C_vac by the sign of p_s(t1)).
+  double conductance_at(double t1) const {
+    return has_vacuum_conductance && supply_gauge_pressure(t1) < 0 ? vacuum_conductance(t1) : conductance(t1);
+  }
 };
 
 class GasCavityTerm : public CavityVolumeTerm {

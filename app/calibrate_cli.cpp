@@ -3,6 +3,7 @@
 
 #include <petscsys.h>
 
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <ctime>
@@ -41,21 +42,19 @@ const char* kCalibrateUsage =
     "        test reproduces the measured curves (PETSc TAO POUNDERS); values, residuals,\n"
     "        95 % confidence intervals, overlay plot, calibration file\n"
     "  materials [--data-dir DIR] [--max-strain 2.0] [--out DIR]\n"
-    "        neo-Hookean, Yeoh and Ogden fits to tensile exports with R^2, RMS and plots\n";
+    "        neo-Hookean, Yeoh and Ogden fits to tensile exports with R^2, RMS and plots\n"
+    "  morphing [--scene FILE] [--inflate-s 11.5] [--deflate-s 4.7] [--diameter-m 0.07]\n"
+    "        [--height-m 0.012] [--fraction 0.9] [--tolerance 0.02] [--max-runs 5] [--out DIR]\n"
+    "        [--set KEY=VALUE]...\n"
+    "        the core valve's supply and vacuum conductances so the morph scene (default\n"
+    "        examples/physical/morph_valve_slice.yaml) turns flat -> cylinder and back in the\n"
+    "        measured times; inflated diameter and flat height against the measured ones;\n"
+    "        calibration file\n";
 
 std::string plot_script() { return std::string(MORPHFEM_SOURCE_DIR) + "/scripts/plot_calibration.py"; }
 
 bool run_plot(const std::vector<std::string>& args) {
   return run_plot_script("plot_calibration.py", args, "the calibration");
-}
-
-double number_option(const std::string& command, const std::string& option, const std::string& text, double lo,
-                     double hi) {
-  double v;
-  if (!parse_export_number(text, false, v) || v < lo || v > hi)
-    throw InputError("calibrate " + command,
-                     option + " '" + text + "' must be a number in [" + json_number(lo) + ", " + json_number(hi) + "]");
-  return v;
 }
 
 int rank_of(MPI_Comm comm) {
@@ -145,14 +144,43 @@ int materials_main(const std::vector<std::string>& args) {
   fit_materials_main(pass, default_dir, std::cout);
   const std::string png = (std::filesystem::path(dir) / "material_fit.png").string();
   if (run_plot({"materials", curves, png})) std::cout << "plot: " << png << "\n";
+  // The calibration file scenes load: {calibration: materials.yaml, parameter: dragonskin10.yeoh.c1}.
+  std::string data_dir = default_dir;
+  double max_strain = 2.0;
+  for (size_t i = 0; i + 1 < pass.size(); ++i) {
+    if (pass[i] == "--data-dir") data_dir = pass[i + 1];
+    if (pass[i] == "--max-strain") max_strain = number_option("materials", "--max-strain", pass[i + 1], 0.05, 20);
+  }
+  Calibration cal;
+  cal.kind = "materials";
+  cal.command = "morphfem calibrate materials";
+  for (const auto& a : args) cal.command += " " + a;
+  cal.created = now_utc();
+  cal.group = {{"data_dir", data_dir}, {"max_strain", json_number(max_strain)}};
+  std::set<std::string> seen, files;
+  for (const MaterialFits& m : fit_material_directory(data_dir, max_strain)) {
+    std::string slug;  // "DragonSkin10" -> "dragonskin10"
+    for (char ch : m.test.material)
+      if (std::isalnum(static_cast<unsigned char>(ch))) slug += static_cast<char>(std::tolower(ch));
+    for (int k = 2; seen.count(slug); ++k) slug += "_" + std::to_string(k);
+    seen.insert(slug);
+    for (const FitResult& f : m.fits) {
+      if (f.std_errors.empty()) continue;  // the linear fits (neo-Hookean, Yeoh) carry standard errors
+      for (size_t j = 0; j < f.names.size(); ++j) {
+        const double v = f.values[j], se = f.std_errors[j];
+        cal.parameters.emplace_back(slug + "." + f.model + "." + f.names[j],
+                                    CalibratedValue{v, se, v - 1.96 * se, v + 1.96 * se, "Pa"});
+      }
+      cal.fit[slug + "." + f.model + ".r2"] = json_number(f.r2);
+      cal.fit[slug + "." + f.model + ".rms_Pa"] = json_number(f.rms);
+    }
+    if (files.insert(m.test.file).second) cal.data.push_back({m.test.file, sha256_file(m.test.file), m.test.material});
+  }
+  cal.fit["method"] = "linear least squares on the uniaxial nominal stress (fem/material_fit.h)";
+  const std::string yaml = (std::filesystem::path(dir) / "materials.yaml").string();
+  write_calibration_file(yaml, cal);
+  std::cout << "calibration: " << yaml << "\n";
   return 0;
-}
-
-std::string now_utc() {
-  const std::time_t t = std::time(nullptr);
-  char buf[32];
-  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&t));
-  return buf;
 }
 
 // `calibrate friction`: one group (surface, foot state) of pull tests -> fitted model.
@@ -268,6 +296,22 @@ int friction_main(const std::vector<std::string>& args, MPI_Comm comm) {
 
 }  // namespace
 
+double number_option(const std::string& command, const std::string& option, const std::string& text, double lo,
+                     double hi) {
+  double v;
+  if (!parse_export_number(text, false, v) || v < lo || v > hi)
+    throw InputError("calibrate " + command,
+                     option + " '" + text + "' must be a number in [" + json_number(lo) + ", " + json_number(hi) + "]");
+  return v;
+}
+
+std::string now_utc() {
+  const std::time_t t = std::time(nullptr);
+  char buf[32];
+  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&t));
+  return buf;
+}
+
 FrictionFitResult fit_friction(const std::vector<PullCurve>& curves, double weight_N, const FrictionFitOptions& options,
                                MPI_Comm comm) {
   if (curves.empty()) throw InputError("friction fit", "no curves");
@@ -348,6 +392,7 @@ int calibrate_main(const std::vector<std::string>& args, MPI_Comm comm) {
   if (command == "drag") return drag_main(rest, comm);
   if (command == "materials") return materials_main(rest);
   if (command == "friction") return friction_main(rest, comm);
+  if (command == "morphing") return calibrate_morphing_main(rest, comm);
   throw InputError("morphfem calibrate", "unknown command '" + command + "'\n" + kCalibrateUsage);
 }
 

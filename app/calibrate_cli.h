@@ -32,6 +32,15 @@ struct FrictionFitResult {
 FrictionFitResult fit_friction(const std::vector<PullCurve>& curves, double weight_N, const FrictionFitOptions& options,
                                MPI_Comm comm);
 
+// The morphing fit, `morphfem calibrate morphing ...` (app/calibrate_morphing.cpp).
+int calibrate_morphing_main(const std::vector<std::string>& args, MPI_Comm comm);
+
+// Shared by the calibrate commands: a numeric option in [lo, hi] (InputError naming
+// the command and option otherwise), and the time stamp of calibration files.
+double number_option(const std::string& command, const std::string& option, const std::string& text, double lo,
+                     double hi);
+std::string now_utc();
+
 // Runs the calibrate command; returns the process exit status. Throws InputError on bad arguments.
 int calibrate_main(const std::vector<std::string>& args, MPI_Comm comm);
 

@@ -423,24 +423,6 @@ int ladder(const std::vector<std::string>& args, MPI_Comm comm) {
   return 0;
 }
 
-// Extents of the deformed mid-length cross-section [m]: x (width), y (length of the
-// whole body), z (thickness). The cross-section is the nodes within 10 % of the body
-// length of its middle (reference y), away from the sealed ends that stay flat.
-Eigen::Vector3d extents(const Mesh& mesh, const RowMatrixXd& u) {
-  const double y0 = mesh.X.col(1).minCoeff(), y1 = mesh.X.col(1).maxCoeff(), mid = 0.5 * (y0 + y1);
-  Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = -lo;
-  double ylo = 1e300, yhi = -1e300;
-  for (int n = 0; n < mesh.n_nodes(); ++n) {
-    const Eigen::Vector3d x = mesh.X.row(n).transpose() + u.row(n).transpose();
-    ylo = std::min(ylo, x.y());
-    yhi = std::max(yhi, x.y());
-    if (std::abs(mesh.X(n, 1) - mid) > 0.1 * (y1 - y0)) continue;
-    lo = lo.cwiseMin(x);
-    hi = hi.cwiseMax(x);
-  }
-  return {hi.x() - lo.x(), yhi - ylo, hi.z() - lo.z()};
-}
-
 // The voxel study's friction sweep: rows (low, high, distance, time, BLs).
 std::vector<std::array<double, 3>> read_sfrict(const std::string& path) {
   std::ifstream in(path);
@@ -544,7 +526,8 @@ int morph(const std::vector<std::string>& args, MPI_Comm comm) {
   YAML::Node doc = load_scene_yaml(path);
   for (const std::string& assignment : options(args, "--set")) set_scene_key(doc, assignment, path);
   Scene scene = scene_from_yaml(doc, path);
-  if (scene.cavities.empty()) throw InputError(path, "morph needs a pressurised core (loads.cavities)");
+  if (scene.cavities.empty() && scene.gas_cavities.empty())
+    throw InputError(path, "morph needs a pressurised core (loads.cavities or loads.gas_cavities)");
   const std::string out_dir =
       option(args, "--out", scene.output_dir.empty() ? "results/robot/morph" : scene.output_dir);
   scene.output_dir = out_dir;
@@ -554,7 +537,7 @@ int morph(const std::vector<std::string>& args, MPI_Comm comm) {
   std::vector<Sample> samples;
   RunOptions options;
   options.on_step = [&](double t, const Mesh& mesh, const RowMatrixXd& u, const SimulationResult& r) {
-    const Eigen::Vector3d e = extents(mesh, u);
+    const Eigen::Vector3d e = cross_section_extents(mesh, u);
     samples.push_back({t, r.cavity_pressure.at(0), e.x(), e.y(), e.z()});
   };
   const SimulationResult r = run_scene(scene, comm, options);
@@ -589,6 +572,21 @@ int morph(const std::vector<std::string>& args, MPI_Comm comm) {
 }
 
 }  // namespace
+
+Eigen::Vector3d cross_section_extents(const Mesh& mesh, const RowMatrixXd& u) {
+  const double y0 = mesh.X.col(1).minCoeff(), y1 = mesh.X.col(1).maxCoeff(), mid = 0.5 * (y0 + y1);
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = -lo;
+  double ylo = 1e300, yhi = -1e300;
+  for (int n = 0; n < mesh.n_nodes(); ++n) {
+    const Eigen::Vector3d x = mesh.X.row(n).transpose() + u.row(n).transpose();
+    ylo = std::min(ylo, x.y());
+    yhi = std::max(yhi, x.y());
+    if (std::abs(mesh.X(n, 1) - mid) > 0.1 * (y1 - y0)) continue;
+    lo = lo.cwiseMin(x);
+    hi = hi.cwiseMax(x);
+  }
+  return {hi.x() - lo.x(), yhi - ylo, hi.z() - lo.z()};
+}
 
 int robot_main(const std::vector<std::string>& args, MPI_Comm comm) {
   if (args.empty() || args[0] == "--help" || args[0] == "-h") {

@@ -84,6 +84,11 @@ double robot_speed(const Genome& genome, double slope_deg, const std::string& fi
 // Registers "robot" with optim/fitness.h (called by the program before a search).
 void register_robot_fitness();
 
+// Extents of the deformed mid-length cross-section [m]: x (width), y (length of the
+// whole body), z (thickness). The cross-section is the nodes within 10 % of the body
+// length of its middle (reference y), away from the sealed ends that stay flat.
+Eigen::Vector3d cross_section_extents(const Mesh& mesh, const RowMatrixXd& u);
+
 // `morphfem robot validate|ladder ...` (usage in robot_study.cpp).
 int robot_main(const std::vector<std::string>& args, MPI_Comm comm);
 

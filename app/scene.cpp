@@ -140,8 +140,11 @@ struct Reader {
           p.set(k, d, at(v));
         else
           p.set_string(k, v.Scalar(), at(v));
+      } else if (v.IsMap()) {  // {calibration: FILE, parameter: NAME}
+        p.set(k, calibrated_number(v, context + "." + k), at(v));
       } else {
-        fail(v, context + "." + k, "expected a number, a list of numbers or text");
+        fail(v, context + "." + k,
+             "expected a number, a list of numbers, text or {calibration: FILE, parameter: NAME}");
       }
     }
     return p;
@@ -302,7 +305,7 @@ Scene scene_from_yaml(const YAML::Node& root, const std::string& path) {
         const std::string key = "loads.gas_cavities";
         r.allow(c, key,
                 {"name", "surfaces", "volume_axes", "open_axis", "symmetry_factor", "temperature",
-                 "initial_gauge_pressure", "supply_pressure", "conductance"});
+                 "initial_gauge_pressure", "supply_pressure", "conductance", "vacuum_conductance"});
         GasCavitySpec spec;
         if (!c["surfaces"]) r.fail(c, key, "missing key 'surfaces'");
         spec.wall.name =
@@ -319,15 +322,20 @@ Scene scene_from_yaml(const YAML::Node& root, const std::string& path) {
         positive("temperature", spec.temperature);
         if (c["initial_gauge_pressure"])
           spec.initial_gauge_pressure = r.number(c["initial_gauge_pressure"], key + ".initial_gauge_pressure");
+        // A number (or a calibrated value) held constant, or a table [[t, value], ...].
         auto constant_or_table = [&](const char* k, TimeFunction& out) {
           if (!c[k]) return;
-          out = c[k].IsScalar() ? TimeFunction::constant(r.number(c[k], key + "." + k))
-                                : r.ramp_or_table(c[k], key + "." + k, end);
+          out = c[k].IsSequence() ? r.ramp_or_table(c[k], key + "." + k, end)
+                                  : TimeFunction::constant(r.calibrated_number(c[k], key + "." + k));
         };
         constant_or_table("supply_pressure", spec.supply_gauge_pressure);
         constant_or_table("conductance", spec.conductance);
-        for (const auto& [t, v] : spec.conductance.points())
-          if (v < 0) r.fail(c["conductance"], key + ".conductance", "must not be negative");
+        constant_or_table("vacuum_conductance", spec.vacuum_conductance);
+        spec.has_vacuum_conductance = static_cast<bool>(c["vacuum_conductance"]);
+        for (const auto& [k, f] :
+             {std::pair{"conductance", &spec.conductance}, std::pair{"vacuum_conductance", &spec.vacuum_conductance}})
+          for (const auto& [t, v] : f->points())
+            if (v < 0) r.fail(c[k], key + "." + k, "must not be negative");
         scene.gas_cavities.push_back(spec);
       }
     }
@@ -442,7 +450,8 @@ Scene scene_from_yaml(const YAML::Node& root, const std::string& path) {
       }
     }
     if (const auto sc = c["self"]) {
-      r.allow(sc, "contact.self", {"pairs", "dhat", "kappa", "inflation"});
+      r.allow(sc, "contact.self", {"pairs", "dhat", "kappa", "inflation", "start"});
+      if (sc["start"]) scene.self_contact_spec.start = r.number(sc["start"], "contact.self.start");
       scene.self_contact = true;
       const YAML::Node pairs = sc["pairs"];
       if (!pairs || !pairs.IsSequence() || pairs.size() == 0)

@@ -23,8 +23,11 @@
 //     gas_cavities:                             # isothermal ideal gas fed through a valve
 //       - {name: core, surfaces: [inner], volume_axes: [x, y, z], symmetry_factor: 1,
 //          temperature: 293.15, initial_gauge_pressure: 0,          # K, Pa
-//          supply_pressure: 50e3, conductance: 1e-8}                # Pa (gauge), mol/(s Pa)
-//         # supply_pressure / conductance: a number (constant) or a table [[t, v], ...]
+//          supply_pressure: 50e3, conductance: 1e-8,                # Pa (gauge), mol/(s Pa)
+//          vacuum_conductance: 3e-8}                                # while supply_pressure < 0
+//         # supply_pressure / (vacuum_)conductance: a number (constant), a table
+//         # [[t, v], ...] or a calibrated value {calibration: FILE, parameter: NAME}
+//         # (`morphfem calibrate morphing` writes conductance_supply / _vacuum)
 //     tractions:
 //       - {surface: tip, traction: [0, 0, -100]}  # dead load [Pa], ramped like pressure
 //     pulls:                                    # test machine pulling a region through a spring
@@ -42,10 +45,13 @@
 //                regions: [{surface: zmin, mu_static: 0.5, mu_kinetic: 0.4}]}
 //                # mu: a number or a table [[t, mu], ...] (coefficients that change over time)
 //                # or a calibrated value {calibration: FILE, parameter: mu_static}
-//                # (`morphfem calibrate friction` writes FILE; also for feet.mu_active/inactive)
-//     self: {pairs: [[cavity_top, cavity_bottom]], dhat: 0, kappa: 0, inflation: 0}
+//                # (`morphfem calibrate friction` writes FILE; also for feet.mu_active/inactive,
+//                # material and geometry parameters; `calibrate materials` writes e.g.
+//                # dragonskin10.yeoh.c1)
+//     self: {pairs: [[cavity_top, cavity_bottom]], dhat: 0, kappa: 0, inflation: 0, start: 2.0}
 //           # surfaces that may touch (a name twice: within one surface); 0: defaults
-//           # (contact/self_contact.h: dhat 1e-3 x box diagonal, kappa 3 mu, inflation 20 dhat)
+//           # (contact/self_contact.h: dhat 1e-3 x box diagonal, kappa 3 mu, inflation 20 dhat);
+//           # start [s]: the barrier acts only from then on (default: from the start)
 //   actuation:                                  # a schedule file shared with `morphfem hw play`
 //     {schedule: schedules/rolling.yaml, start: 1.0,      # gait time 0 at t = start [s]
 //      bladders: {b1: bladder_1_wall, ...},               # channel -> cavity wall surface

@@ -376,6 +376,11 @@ SelfContactTerm::SelfContactTerm(const Mesh& mesh, const Partition& partition, i
       throw InputError(where, "surfaces touch at the start (edges " + std::to_string(ep.nodes[0]) + "-" +
                                   std::to_string(ep.nodes[1]) + " and " + std::to_string(ep.nodes[2]) + "-" +
                                   std::to_string(ep.nodes[3]) + ")");
+  if (spec_.start > -std::numeric_limits<double>::infinity()) {  // off until start (refresh_pieces)
+    active_ = false;
+    pairs_.clear();
+    edge_pairs_.clear();
+  }
 }
 
 Eigen::Matrix<double, 4, 3> SelfContactTerm::positions(const std::array<int, 4>& nodes, const RowMatrixXd& u) const {
@@ -530,6 +535,7 @@ double SelfContactTerm::piece(int k, const PieceState& s, Eigen::VectorXd* g, Ei
 }
 
 double SelfContactTerm::max_step(Assembler& assembler, Vec u, Vec du) {
+  if (!active_) return 1.0;  // the same on every rank
   const std::vector<double> u_local = assembler.gather(u);
   const std::vector<double>& du_local = assembler.gather(du);
   const auto U = [&](int n) { return Eigen::Vector3d::Map(&u_local[3 * assembler.node_slot(n)]); };
@@ -572,7 +578,17 @@ double SelfContactTerm::max_step(Assembler& assembler, Vec u, Vec du) {
 }
 
 bool SelfContactTerm::refresh_pieces(Assembler& assembler, Vec u0) {
-  const RowMatrixXd U = assembler.gather_all(u0);  // the same field on every rank: the same decision
+  if (!active_ && !(time_ >= spec_.start)) return false;  // the same time on every rank
+  return refresh_pieces(assembler.gather_all(u0));        // the same field on every rank: the same decision
+}
+
+bool SelfContactTerm::refresh_pieces(const RowMatrixXd& U) {
+  if (!active_ && !(time_ >= spec_.start)) return false;
+  if (!active_) {
+    active_ = true;
+    refresh(U);
+    return true;
+  }
   double moved = 0.0;
   for (int a : surface_nodes_) moved = std::max(moved, (U.row(a).transpose() - anchor_[a]).norm());
   if (moved <= 0.25 * spec_.inflation) return false;

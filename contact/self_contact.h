@@ -47,6 +47,7 @@
 // |du_j - du_o|, o the first node of e. So alpha <= s d / L keeps d >= (1 - s) d > 0.
 #pragma once
 #include <array>
+#include <limits>
 #include <string>
 #include <utility>
 #include <vector>
@@ -69,6 +70,11 @@ struct SelfContactSpec {
   double max_step_fraction = 0.9;
   bool project_hessian = true;  // per-pair PSD projection of the barrier Hessian
   bool edge_edge = true;        // include the edge-edge pairs
+  // The barrier acts from this time on [s] (-inf: always). Before it the term has no
+  // pieces: no candidates, no CCD bound, no trust region (a scene whose surfaces
+  // meet only late, e.g. a core closing under vacuum after inflating, does not pay
+  // for them earlier). It switches on at the first step starting at t >= start.
+  double start = -std::numeric_limits<double>::infinity();
 };
 
 // Point-triangle barrier kernel: x is 4 x 3 (point, then triangle vertices a, b, c)
@@ -103,13 +109,20 @@ class SelfContactTerm : public EnergyTerm {
   SelfContactTerm(const Mesh& mesh, const Partition& partition, int rank, SelfContactSpec spec);
 
   std::string name() const override { return "self_contact:" + spec_.name; }
-  int n_pieces() const override { return static_cast<int>(pairs_.size() + edge_pairs_.size() + trust_nodes_.size()); }
+  int n_pieces() const override {
+    return active_ ? static_cast<int>(pairs_.size() + edge_pairs_.size() + trust_nodes_.size()) : 0;
+  }
   void piece_nodes(int k, std::vector<int>& nodes) const override;
   double piece(int k, const PieceState& s, Eigen::VectorXd* g, Eigen::MatrixXd* H) const override;
   double max_step(Assembler& assembler, Vec u, Vec du) override;
   // Rebuilds the candidates at u0 once a surface node moved more than r/4 since
   // the last refresh (returns true: the solver re-creates the pattern). Collective.
   bool refresh_pieces(Assembler& assembler, Vec u0) override;
+  // The same decision from the whole displacement field (identical on every rank);
+  // also switches the term on at its start time.
+  bool refresh_pieces(const RowMatrixXd& u);
+  void set_time(double t) override { time_ = t; }
+  bool active() const { return active_; }
 
   // Rebuilds the candidate pairs at displacement u (collective) and moves the
   // trust anchor there. The pieces change: call assembler.setup() afterwards and
@@ -164,6 +177,8 @@ class SelfContactTerm : public EnergyTerm {
   std::vector<int> surface_nodes_;       // every surface node
   std::vector<Eigen::Vector3d> anchor_;  // per mesh node: displacement at the last refresh [m]
   int n_refreshes_ = 0;
+  bool active_ = true;
+  double time_ = 0.0;  // the solver's current time [s] (set_time)
 };
 
 }  // namespace morphfem

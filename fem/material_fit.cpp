@@ -154,13 +154,34 @@ Eigen::VectorXd linear_lsq(const Eigen::MatrixXd& B, const Eigen::VectorXd& P) {
   return Bs.colPivHouseholderQr().solve(P).cwiseQuotient(scale);
 }
 
+// Standard errors of linear least-squares coefficients c of y ~ B c (see FitResult).
+std::vector<double> linear_std_errors(const Eigen::MatrixXd& B, const Eigen::VectorXd& y, const Eigen::VectorXd& c) {
+  const long n = B.rows(), p = B.cols();
+  if (n <= p) return std::vector<double>(static_cast<size_t>(p), std::numeric_limits<double>::quiet_NaN());
+  const double s2 = (y - B * c).squaredNorm() / static_cast<double>(n - p);
+  // (B^T B)^-1 through the column-scaled normal matrix (columns differ by orders).
+  Eigen::VectorXd scale = B.colwise().norm().transpose();
+  for (int j = 0; j < scale.size(); ++j)
+    if (scale(j) == 0.0) scale(j) = 1.0;
+  const Eigen::MatrixXd Bs = B * scale.cwiseInverse().asDiagonal();
+  const Eigen::MatrixXd inv = (Bs.transpose() * Bs).inverse();
+  std::vector<double> se(static_cast<size_t>(p));
+  for (long j = 0; j < p; ++j) se[static_cast<size_t>(j)] = std::sqrt(s2 * inv(j, j)) / scale(j);
+  return se;
+}
+
 }  // namespace
 
 FitResult fit_neo_hookean(const std::vector<double>& stretch, const std::vector<double>& P) {
   check_fit_data(stretch, P, 1);
+  const int n = static_cast<int>(stretch.size());
+  Eigen::MatrixXd B(n, 1);
+  Eigen::VectorXd y(n);
   double num = 0, den = 0;
-  for (size_t i = 0; i < stretch.size(); ++i) {
+  for (int i = 0; i < n; ++i) {
     const double f = stretch[i] - 1.0 / (stretch[i] * stretch[i]);
+    B(i, 0) = f;
+    y(i) = P[i];
     num += f * P[i];
     den += f * f;
   }
@@ -168,6 +189,7 @@ FitResult fit_neo_hookean(const std::vector<double>& stretch, const std::vector<
   r.model = "neo_hookean";
   r.names = {"mu"};
   r.values = {num / den};
+  r.std_errors = linear_std_errors(B, y, Eigen::VectorXd::Constant(1, num / den));
   r.small_strain_mu = r.values[0];
   r.stable = r.values[0] > 0.0;
   r.rms = rms_error(stretch, P, [&](double l) { return uniaxial_stress_neo_hookean(l, r.values[0]); });
@@ -190,6 +212,7 @@ FitResult fit_yeoh(const std::vector<double>& stretch, const std::vector<double>
   r.model = "yeoh";
   r.names = {"c1", "c2", "c3"};
   r.values = {c(0), c(1), c(2)};
+  r.std_errors = linear_std_errors(B, y, c);
   r.small_strain_mu = 2.0 * c(0);
   // Stable if dW/dI1 = c1 + 2 c2 x + 3 c3 x^2 > 0 for 0 <= x <= 7 (the range the law accepts).
   r.stable = c(0) > 0.0;
@@ -350,6 +373,28 @@ void select_strain_range(const TensileTest& test, double max_strain, std::vector
 // ---------------------------------------------------------------------------------
 // Command line.
 
+std::vector<MaterialFits> fit_material_directory(const std::string& data_dir, double max_strain) {
+  namespace fs = std::filesystem;
+  if (!fs::is_directory(data_dir)) throw InputError(data_dir, "data directory does not exist");
+  std::vector<std::string> files;
+  for (const auto& entry : fs::directory_iterator(data_dir))
+    if (entry.is_regular_file() && entry.path().extension() == ".csv") files.push_back(entry.path().string());
+  std::sort(files.begin(), files.end());
+  if (files.empty()) throw InputError(data_dir, "no *.csv tensile-test files in the data directory");
+  std::vector<MaterialFits> out;
+  for (const auto& file : files)
+    for (auto& t : read_tensile_tests(file)) {  // every specimen block of every file
+      MaterialFits m;
+      m.test = std::move(t);
+      m.max_strain = max_strain;
+      select_strain_range(m.test, max_strain, m.stretch, m.stress);
+      m.fits = {fit_neo_hookean(m.stretch, m.stress), fit_yeoh(m.stretch, m.stress)};
+      for (int N = 1; N <= 3; ++N) m.fits.push_back(fit_ogden(m.stretch, m.stress, N));
+      out.push_back(std::move(m));
+    }
+  return out;
+}
+
 int fit_materials_main(const std::vector<std::string>& args, const std::string& default_data_dir, std::ostream& out) {
   const std::string usage =
       "usage: morphfem fit-materials [--data-dir DIR] [--max-strain 2.0] [--json] [--curves FILE.csv]";
@@ -383,26 +428,15 @@ int fit_materials_main(const std::vector<std::string>& args, const std::string& 
   }
   if (data_dir.empty()) throw InputError("fit-materials", "no data directory: give --data-dir DIR");
   namespace fs = std::filesystem;
-  if (!fs::is_directory(data_dir)) throw InputError(data_dir, "data directory does not exist");
-  std::vector<std::string> files;
-  for (const auto& entry : fs::directory_iterator(data_dir))
-    if (entry.is_regular_file() && entry.path().extension() == ".csv") files.push_back(entry.path().string());
-  std::sort(files.begin(), files.end());
-  if (files.empty()) throw InputError(data_dir, "no *.csv tensile-test files in the data directory");
-
   std::vector<Json> json_materials;
   std::ostringstream curves;
   curves << "material,stretch,data_nominal_stress_pa,neo_hookean_pa,yeoh_pa,ogden1_pa,ogden2_pa,ogden3_pa\n";
   curves << std::setprecision(10);
-  std::vector<TensileTest> tests;  // every specimen block of every file
-  for (const auto& file : files)
-    for (auto& t : read_tensile_tests(file)) tests.push_back(std::move(t));
-  for (const TensileTest& test : tests) {
+  for (const MaterialFits& m : fit_material_directory(data_dir, max_strain)) {
+    const TensileTest& test = m.test;
     const std::string& file = test.file;
-    std::vector<double> stretch, P;
-    select_strain_range(test, max_strain, stretch, P);
-    std::vector<FitResult> fits = {fit_neo_hookean(stretch, P), fit_yeoh(stretch, P)};
-    for (int N = 1; N <= 3; ++N) fits.push_back(fit_ogden(stretch, P, N));
+    const std::vector<double>&stretch = m.stretch, &P = m.stress;
+    const std::vector<FitResult>& fits = m.fits;
 
     if (json) {
       std::vector<Json> json_fits;

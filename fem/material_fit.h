@@ -55,11 +55,14 @@ struct FitResult {
   std::string model;               // "neo_hookean", "yeoh", "ogden"
   std::vector<std::string> names;  // coefficient names: mu | c1 c2 c3 | mu1 alpha1 ...
   std::vector<double> values;      // [Pa] for moduli, [-] for exponents
-  double rms = 0;                  // RMS error of P [Pa]
-  double r2 = 0;                   // coefficient of determination 1 - SS_res / SS_tot [-]
-  double small_strain_mu = 0;      // small-strain shear modulus [Pa]
-  bool stable = true;              // usable as a law (Yeoh: dW/dI1 > 0 up to x = 7; Ogden: mu_p alpha_p > 0)
-  bool converged = true;           // iterative fits only
+  // Standard errors of the linear fits (neo-Hookean, Yeoh): sqrt of the diagonal of
+  // s^2 (B^T B)^-1, s^2 = SS_res / (n - p); empty for the iterative (Ogden) fits.
+  std::vector<double> std_errors;
+  double rms = 0;              // RMS error of P [Pa]
+  double r2 = 0;               // coefficient of determination 1 - SS_res / SS_tot [-]
+  double small_strain_mu = 0;  // small-strain shear modulus [Pa]
+  bool stable = true;          // usable as a law (Yeoh: dW/dI1 > 0 up to x = 7; Ogden: mu_p alpha_p > 0)
+  bool converged = true;       // iterative fits only
   double value(const std::string& name) const;
 };
 
@@ -71,6 +74,17 @@ FitResult fit_ogden(const std::vector<double>& stretch, const std::vector<double
 // point beyond it, so a post-failure tail is never used).
 void select_strain_range(const TensileTest& test, double max_strain, std::vector<double>& stretch,
                          std::vector<double>& P);
+
+// Every specimen of every *.csv export in `data_dir` (sorted by file name) fitted
+// over 0 < engineering strain <= max_strain: neo-Hookean, Yeoh, Ogden N = 1, 2, 3 (in
+// that order). InputError for a missing or empty directory or a malformed file.
+struct MaterialFits {
+  TensileTest test;
+  double max_strain = 0;
+  std::vector<double> stretch, stress;  // the fitted points: lambda [-], P [Pa]
+  std::vector<FitResult> fits;
+};
+std::vector<MaterialFits> fit_material_directory(const std::string& data_dir, double max_strain);
 
 // `morphfem fit-materials [--data-dir DIR] [--max-strain 2.0] [--json] [--curves FILE]`:
 // fits every *.csv in DIR (default `default_data_dir`) and prints a table per material

@@ -304,6 +304,39 @@ double term_energy(const EnergyTerm& term, const Mesh& mesh, const RowMatrixXd& 
 
 }  // namespace
 
+TEST(SelfContactTerm, StartsAtItsStartTime) {
+  ParamSet p("plate");
+  p.set_string("type", "block");
+  p.set("lx", 0.04);
+  p.set("ly", 0.04);
+  p.set("lz", 0.004);
+  p.set("mesh_size", 0.02);
+  const Mesh mesh = build_geometry(p);
+  Partition part;
+  part.cell_part.assign(mesh.n_cells(), 0);
+  part.node_begin = {0, mesh.n_nodes()};
+  SelfContactSpec spec;
+  spec.pairs = {{"zmin", "zmax"}};
+  spec.dhat = 1e-3;
+  spec.kappa = 1e6;
+  spec.inflation = 0.0045;
+  const int always = SelfContactTerm(mesh, part, 0, spec).n_pieces();
+  ASSERT_GT(always, 0);
+  spec.start = 1.0;
+  SelfContactTerm term(mesh, part, 0, spec);
+  const RowMatrixXd zero = RowMatrixXd::Zero(mesh.n_nodes(), 3);
+  EXPECT_FALSE(term.active());
+  EXPECT_EQ(term.n_pieces(), 0);  // no candidates, no trust region before the start
+  term.set_time(0.999);
+  EXPECT_FALSE(term.refresh_pieces(zero));
+  EXPECT_EQ(term.n_pieces(), 0);
+  term.set_time(1.0);
+  EXPECT_TRUE(term.refresh_pieces(zero));  // on: the pattern must be rebuilt
+  EXPECT_TRUE(term.active());
+  EXPECT_EQ(term.n_pieces(), always);
+  EXPECT_FALSE(term.refresh_pieces(zero));  // nothing moved since
+}
+
 TEST(SelfContactTerm, EdgePairsStopCrossingEdgesThatNoVertexSees) {
   const double gap = 2e-4;
   const Mesh mesh = crossing_wedges(gap / 1e-2);
