@@ -153,9 +153,10 @@ int calibrate_morphing_main(const std::vector<std::string>& args, MPI_Comm comm)
       std::fputs(header.c_str(), stdout);
       for (size_t j = 0; j < runs.size(); ++j) {
         const Run& x = runs[j];
+        const std::string deflate_settled = !vacuum ? "-" : x.m.deflate_settled ? "yes" : "no";
         std::printf("  %3zu  %21.4e  %21.4e  %11.3f  %11.3f  %13.2f  %16.2f  %3s/%-3s  %8.1f\n", j + 1, x.C_supply,
                     x.C_vacuum, x.m.inflate_time, x.m.deflate_time, 100 * x.m.inflated_diameter, 100 * x.m.flat_height,
-                    x.m.inflate_settled ? "yes" : "no", x.m.deflate_settled ? "yes" : "no", x.wall_s);
+                    x.m.inflate_settled ? "yes" : "no", deflate_settled.c_str(), x.wall_s);
       }
       std::fflush(stdout);
     }
@@ -205,7 +206,7 @@ int calibrate_morphing_main(const std::vector<std::string>& args, MPI_Comm comm)
   }
   std::printf("  inflated width %.2f cm, height %.2f cm; height before inflating %.2f cm\n", 100 * m.inflated_width,
               100 * m.inflated_height, 100 * m.start_height);
-  if (!m.inflate_settled || !m.deflate_settled)
+  if (!m.inflate_settled || (vacuum && !m.deflate_settled))
     std::printf("  warning: a phase had not settled at its end (lengthen it in the scene's supply table)\n");
   std::printf("  times %s after %zu runs; all four within 10 %%: %s\n", converged ? "converged" : "NOT converged",
               runs.size(), within_10 ? "yes" : "no");
@@ -216,7 +217,10 @@ int calibrate_morphing_main(const std::vector<std::string>& args, MPI_Comm comm)
   cal.command = "morphfem calibrate morphing";
   for (const auto& a : args) cal.command += " " + a;
   cal.created = now_utc();
-  cal.group = {{"scene", o.scene}, {"cavity", core.wall.name}};
+  // The scene as a path relative to the repository when it is in it (files that travel).
+  const std::string source = std::string(MORPHFEM_SOURCE_DIR) + "/";
+  const std::string scene_name = o.scene.rfind(source, 0) == 0 ? o.scene.substr(source.size()) : o.scene;
+  cal.group = {{"scene", scene_name}, {"cavity", core.wall.name}};
   // The published times are means of 20 cycles without a spread: no standard error.
   cal.parameters.emplace_back("conductance_supply",
                               CalibratedValue{best.C_supply, 0.0, best.C_supply, best.C_supply, "mol/(s Pa)"});
