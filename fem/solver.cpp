@@ -227,13 +227,25 @@ PetscErrorCode QuasiStaticSolver::line_search(SNESLineSearch ls) {
   PetscCall(VecNorm(F, NORM_2, &fnorm_old));
   // Largest admissible step along du = -Y (contact barriers, ...).
   double lambda = 1.0;
+  std::string limiter = "none";
   PetscCall(VecCopy(Y, W));
   PetscCall(VecScale(W, -1.0));
-  for (const auto& term : assembler_.terms()) lambda = std::min(lambda, term->max_step(assembler_, X, W));
+  for (const auto& term : assembler_.terms()) {
+    const double l = term->max_step(assembler_, X, W);
+    if (l < lambda) {
+      lambda = l;
+      limiter = term->name();
+    }
+  }
+  // -morphfem_linesearch_monitor: the admissible step, the term that bounds it, and
+  // the accepted step (diagnosing stagnating Newton iterations).
+  PetscBool monitor = PETSC_FALSE;
+  PetscCall(PetscOptionsGetBool(nullptr, nullptr, "-morphfem_linesearch_monitor", &monitor, nullptr));
   if (!(lambda > 0)) {
     PetscCall(SNESLineSearchSetReason(ls, SNES_LINESEARCH_FAILED_DOMAIN));
     return 0;
   }
+  const double lambda_max = lambda;
   bool accepted = false;
   for (int attempt = 0; attempt < 40 && !accepted; ++attempt, lambda *= 0.5) {
     PetscCall(VecWAXPY(W, -lambda, Y, X));
@@ -251,6 +263,9 @@ PetscErrorCode QuasiStaticSolver::line_search(SNESLineSearch ls) {
     }
     if (accepted) break;
   }
+  if (monitor)
+    PetscCall(PetscPrintf(assembler_.comm(), "      line search: max step %.3e (%s), %s %.3e, slope %.3e\n", lambda_max,
+                          limiter.c_str(), accepted ? "accepted" : "rejected down to", lambda, slope));
   if (!accepted) {
     PetscCall(SNESLineSearchSetReason(ls, SNES_LINESEARCH_FAILED_REDUCT));
     return 0;
