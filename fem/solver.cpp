@@ -51,6 +51,7 @@ PetscErrorCode convergence_trampoline(SNES snes, PetscInt it, PetscReal, PetscRe
 
 QuasiStaticSolver::QuasiStaticSolver(Assembler& assembler, std::vector<DirichletCondition> bcs, SolverOptions options)
     : assembler_(assembler), bcs_(std::move(bcs)), opt_(std::move(options)) {
+  PETSC_CHECK(PetscOptionsGetBool(nullptr, nullptr, "-morphfem_linesearch_monitor", &linesearch_monitor_, nullptr));
   std::vector<int> dofs;
   for (const auto& bc : bcs_)
     for (int n : bc.nodes)
@@ -237,10 +238,6 @@ PetscErrorCode QuasiStaticSolver::line_search(SNESLineSearch ls) {
       limiter = term->name();
     }
   }
-  // -morphfem_linesearch_monitor: the admissible step, the term that bounds it, and
-  // the accepted step (diagnosing stagnating Newton iterations).
-  PetscBool monitor = PETSC_FALSE;
-  PetscCall(PetscOptionsGetBool(nullptr, nullptr, "-morphfem_linesearch_monitor", &monitor, nullptr));
   if (!(lambda > 0)) {
     PetscCall(SNESLineSearchSetReason(ls, SNES_LINESEARCH_FAILED_DOMAIN));
     return 0;
@@ -263,7 +260,9 @@ PetscErrorCode QuasiStaticSolver::line_search(SNESLineSearch ls) {
     }
     if (accepted) break;
   }
-  if (monitor)
+  // -morphfem_linesearch_monitor: the admissible step, the term that bounds it, and
+  // the accepted step (diagnosing stagnating Newton iterations).
+  if (linesearch_monitor_)
     PetscCall(PetscPrintf(assembler_.comm(), "      line search: max step %.3e (%s), %s %.3e, slope %.3e\n", lambda_max,
                           limiter.c_str(), accepted ? "accepted" : "rejected down to", lambda, slope));
   if (!accepted) {

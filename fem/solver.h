@@ -103,8 +103,9 @@ class QuasiStaticSolver {
   double t_ = 0.0, dt_prev_ = 0.0;
   int pattern_rebuilds_ = 0;
   double fnorm0_ = 0.0, fnorm_scale_ = 0.0;
-  double fnorm_prev_ = 0.0;  // residual of the previous iteration [N]
-  int stalled_its_ = 0;      // consecutive iterations without a 10 % residual decrease
+  double fnorm_prev_ = 0.0;                     // residual of the previous iteration [N]
+  int stalled_its_ = 0;                         // consecutive iterations without a 10 % residual decrease
+  PetscBool linesearch_monitor_ = PETSC_FALSE;  // -morphfem_linesearch_monitor (read once)
   double length_scale_ = 1.0;
   double advised_dt_ =
       1e300;  // smallest dt_next advised by the terms for the last attempt  // diagonal of the mesh's bounding box [m]

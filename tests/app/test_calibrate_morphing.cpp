@@ -17,16 +17,10 @@
 #include "app/scene.h"
 #include "core/errors.h"
 #include "optim/calibration_file.h"
+#include "tests/app/temp_dir.h"
 
 namespace morphfem {
 namespace {
-
-std::filesystem::path temp_dir(const std::string& name) {
-  auto dir = std::filesystem::path(::testing::TempDir()) / (name + "_" + std::to_string(::getpid()));
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
-  return dir;
-}
 
 std::string balloon_scene(const std::filesystem::path& dir, const std::string& cavity) {
   const std::string path = (dir / "balloon.yaml").string();

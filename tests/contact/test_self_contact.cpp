@@ -91,24 +91,42 @@ TEST(SelfContactKernel, BarrierGradientAndHessianMatchFiniteDifferences) {
     }
 }
 
+namespace {
+
+// A 40 x 40 x 4 mm plate (mesh_size 20 mm) on one rank, and a spec whose barrier
+// (dhat 1 mm) is off across the plate but whose candidates (20 dhat + r) reach it.
+Mesh thin_plate(int order) {
+  ParamSet p("plate");
+  p.set_string("type", "block");
+  p.set("lx", 0.04);
+  p.set("ly", 0.04);
+  p.set("lz", 0.004);
+  p.set("mesh_size", 0.02);
+  p.set("order", order);
+  return build_geometry(p);
+}
+Partition one_rank(const Mesh& mesh) {
+  Partition part;
+  part.cell_part.assign(mesh.n_cells(), 0);
+  part.node_begin = {0, mesh.n_nodes()};
+  return part;
+}
+SelfContactSpec across_the_plate() {
+  SelfContactSpec spec;
+  spec.pairs = {{"zmin", "zmax"}};
+  spec.dhat = 1e-3;
+  spec.kappa = 1e6;
+  spec.inflation = 0.0045;  // reaches across the 4 mm plate
+  return spec;
+}
+
+}  // namespace
+
 TEST(SelfContactTerm, FindsCandidatesAcrossAThinPlateOnP1AndP2) {
   for (int order : {1, 2}) {
-    ParamSet p("plate");
-    p.set_string("type", "block");
-    p.set("lx", 0.04);
-    p.set("ly", 0.04);
-    p.set("lz", 0.004);
-    p.set("mesh_size", 0.02);
-    p.set("order", order);
-    const Mesh mesh = build_geometry(p);
-    Partition part;
-    part.cell_part.assign(mesh.n_cells(), 0);
-    part.node_begin = {0, mesh.n_nodes()};
-    SelfContactSpec spec;
-    spec.pairs = {{"zmin", "zmax"}};
-    spec.dhat = 1e-3;
-    spec.kappa = 1e6;
-    spec.inflation = 0.0045;  // reaches across the 4 mm plate
+    const Mesh mesh = thin_plate(order);
+    const Partition part = one_rank(mesh);
+    const SelfContactSpec spec = across_the_plate();
     SelfContactTerm term(mesh, part, 0, spec);
     EXPECT_GT(term.n_pairs(), 0) << order;
     // No pair is in the barrier at the start (4 mm > dhat): energy 0 everywhere.
@@ -305,21 +323,9 @@ double term_energy(const EnergyTerm& term, const Mesh& mesh, const RowMatrixXd& 
 }  // namespace
 
 TEST(SelfContactTerm, StartsAtItsStartTime) {
-  ParamSet p("plate");
-  p.set_string("type", "block");
-  p.set("lx", 0.04);
-  p.set("ly", 0.04);
-  p.set("lz", 0.004);
-  p.set("mesh_size", 0.02);
-  const Mesh mesh = build_geometry(p);
-  Partition part;
-  part.cell_part.assign(mesh.n_cells(), 0);
-  part.node_begin = {0, mesh.n_nodes()};
-  SelfContactSpec spec;
-  spec.pairs = {{"zmin", "zmax"}};
-  spec.dhat = 1e-3;
-  spec.kappa = 1e6;
-  spec.inflation = 0.0045;
+  const Mesh mesh = thin_plate(1);
+  const Partition part = one_rank(mesh);
+  SelfContactSpec spec = across_the_plate();
   const int always = SelfContactTerm(mesh, part, 0, spec).n_pieces();
   ASSERT_GT(always, 0);
   spec.start = 1.0;
