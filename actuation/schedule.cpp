@@ -275,7 +275,9 @@ Schedule parse_schedule(const std::string& text, const std::string& source) {
   if (root["name"]) s.name = r.text(root["name"], "name");
   if (root["orientation_deg"]) s.orientation_deg = r.number_in(root["orientation_deg"], "orientation_deg", 0, 90);
   if (root["core_pressure_pa"])
-    s.core_pressure_pa = r.number_in(root["core_pressure_pa"], "core_pressure_pa", 0, 12000);
+    // Gauge pressure: no lower than vacuum; the study's genome range is 0..12000 Pa, a
+    // physical robot's core runs from its vacuum to its line pressure (-80 / 50 kPa).
+    s.core_pressure_pa = r.number_in(root["core_pressure_pa"], "core_pressure_pa", -101325, 1e6);
   if (root["column_s"]) s.column_s = r.number_in(root["column_s"], "column_s", 1e-6, 1e6);
   if (root["repeats"]) s.repeats = r.integer_in(root["repeats"], "repeats", 1, 1000000);
   if (root["settle_s"]) s.settle_s = r.number_in(root["settle_s"], "settle_s", 0, 1e6);

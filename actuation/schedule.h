@@ -8,7 +8,7 @@
 //   morphfem_schedule: 1        # format version (required)
 //   name: rolling               # optional label
 //   orientation_deg: 0          # heading vs. uphill, 0..90 (default 0)
-//   core_pressure_pa: 12000     # simulated core pressure, 0..12000 (default 0)
+//   core_pressure_pa: 12000     # core gauge pressure, -101325..1e6 (default 0; genome: 0..12000)
 //   column_s: 1.237             # duration of one column (default 1.237)
 //   repeats: 2                  # the matrix is played this many times (default 1)
 //   settle_s: 0                 # rest phase before column 1 (default 0)

@@ -478,7 +478,7 @@ Scene scene_from_yaml(const YAML::Node& root, const std::string& path) {
     const std::string key = "actuation";
     r.allow(a, key,
             {"schedule", "start", "bladders", "growth", "timing", "core", "core_ramp_s", "volume_axes",
-             "core_open_axis", "feet", "weightless_inflated"});
+             "core_open_axis", "bladders_open_axis", "feet", "weightless_inflated"});
     if (!a["schedule"]) r.fail(a, key, "missing key 'schedule' (a schedule file)");
     if (a["schedule"].IsMap()) {  // the schedule written inline, in the schedule file format
       YAML::Emitter text;
@@ -542,7 +542,14 @@ Scene scene_from_yaml(const YAML::Node& root, const std::string& path) {
         if (channel < 0 || channel >= kNumBladders)
           r.fail(kv.first, key + ".bladders." + name, "not a bladder channel (b1..b8)");
         add_cavity(channel, r.text(kv.second, key + ".bladders." + name));
+        if (a["bladders_open_axis"]) {  // chambers without end walls (a plane-strain slice): open sleeves
+          YAML::Node sleeve;
+          sleeve["open_axis"] = a["bladders_open_axis"];
+          r.open_axis(sleeve, key + ".bladders_open_axis", scene.cavities.back().axes, scene.cavities.back().open_axis);
+        }
       }
+    } else if (a["bladders_open_axis"]) {
+      r.fail(a["bladders_open_axis"], key + ".bladders_open_axis", "needs 'bladders'");
     }
     if (a["core"]) {
       add_cavity(kChannelCore, r.text(a["core"], key + ".core"));

@@ -173,7 +173,7 @@ Mesh mesh_assembly(const Assembly& assembly, double mesh_size, int order, const 
   std::vector<std::string> surface_order;
   for (const Cavity& c : assembly.cavities) surface_order.push_back(c.surface);
   for (const char* name : {"bottom", "foot_a", "foot_b", "outer", "skin_surface", "bladder_surface", "end_a", "end_b"})
-    surface_order.push_back(name);
+    if (assembly.foot_length > 0 || std::string(name).rfind("foot_", 0) != 0) surface_order.push_back(name);  // no feet
   for (const std::string& name : surface_order) add_group(2, surface_tags[name], name);
 
   return mesh_from_current_gmsh_model(source);
@@ -203,9 +203,9 @@ std::string bladder_name(int k) { return "bladder_" + std::to_string(k); }
 // A layer [0, width] x [0, length] x [z0, z1], split at the foot bands' inner ends.
 void add_split_layer(Assembly& a, double width, double z0, double z1, const std::string& region) {
   const double f = a.foot_length, l = a.length;
-  a.pieces.push_back({axis_box(0, width, 0, f, z0, z1), region});
+  if (f > 0) a.pieces.push_back({axis_box(0, width, 0, f, z0, z1), region});
   a.pieces.push_back({axis_box(0, width, f, l - f, z0, z1), region});
-  a.pieces.push_back({axis_box(0, width, l - f, l, z0, z1), region});
+  if (f > 0) a.pieces.push_back({axis_box(0, width, l - f, l, z0, z1), region});
 }
 
 // The core gap z in [z0, z1]: solid bonded strips along x = 0 and x = width (edge wide),
@@ -243,7 +243,7 @@ CommonRobot common_robot(const ParamSet& params, double width, double length, do
   c.seal = params.number_in("end_seal", 0.0, kHuge, seal);  // 0: open ends
   c.bladder_thickness = length_param(params, "bladder_thickness", bladder_thickness);
   c.bladder_width = length_param(params, "bladder_width", bladder_width);
-  c.foot_length = length_param(params, "foot_length", foot_length);
+  c.foot_length = params.number_in("foot_length", 0.0, kHuge, foot_length);  // 0: no feet (a slice)
   require(2 * c.edge < c.width, params, "edge_width", "the two bonded edges must leave a core: 2 edge_width < width");
   require(2 * c.seal < c.length, params, "end_seal", "the two end seals must leave a core: 2 end_seal < length");
   require(4 * c.bladder_width <= c.width, params, "bladder_width",
@@ -291,16 +291,21 @@ Mesh build_robot_voxel(const ParamSet& params) {
 
 Mesh build_robot_physical(const ParamSet& params) {
   params.allow_only({"type", "mesh_size", "order", "width", "length", "skin_thickness", "fabric_thickness", "core_gap",
-                     "edge_width", "end_seal", "bladder_thickness", "bladder_wall", "bladder_width", "foot_length"});
+                     "edge_width", "end_seal", "bladder_thickness", "bladder_wall", "bladder_width", "foot_length",
+                     "bladder_end_walls"});
   const CommonRobot c = common_robot(params, 0.10, 0.15, 0.001, 0.005, 0.005, 0.003, 0.02, 0.02);
+  // 0: chambers open at both ends (no end walls), e.g. for a plane-strain slice in which
+  // the chambers run through the whole slice (foot_length 0) as open sleeves.
+  const bool end_walls = params.integer_in("bladder_end_walls", 0, 1, 1) == 1;
   const double t = length_param(params, "skin_thickness", 0.003);
   const double tf = length_param(params, "fabric_thickness", 0.0005);
   const double w = length_param(params, "bladder_wall", 0.0008);
   require(tf < t, params, "fabric_thickness", "the fabric must be thinner than the skin layer");
   require(2 * w < std::min(c.bladder_thickness, c.bladder_width), params, "bladder_wall",
           "the bladder walls must leave a chamber: 2 bladder_wall < bladder_thickness and bladder_width");
-  require(2 * w < c.length - 2 * c.foot_length, params, "bladder_wall",
-          "the bladder walls must leave a chamber along the axis");
+  if (end_walls)
+    require(2 * w < c.length - 2 * c.foot_length, params, "bladder_wall",
+            "the bladder walls must leave a chamber along the axis");
 
   Assembly a;
   a.length = c.length;
@@ -318,8 +323,9 @@ Mesh build_robot_physical(const ParamSet& params) {
   a.pieces.push_back({axis_box(0, c.width, 0, c.length, z_top, z_top + ds), "skin"});
   a.pieces.push_back({axis_box(0, c.width, 0, c.length, z_top + ds, z_top + ds + tf), "fabric"});
   a.pieces.push_back({axis_box(0, c.width, 0, c.length, z_top + ds + tf, z_upper), "skin"});
-  // Bladders: closed DS30 chambers (floor, roof, two side walls, two end walls).
-  const double y0 = c.foot_length, y1 = c.length - c.foot_length;
+  // Bladders: closed DS30 chambers (floor, roof, two side walls, two end walls), or
+  // without end walls open sleeves along y.
+  const double y0 = c.foot_length, y1 = c.length - c.foot_length, we = end_walls ? w : 0.0;
   for (int k = 1; k <= kBladders; ++k) {
     const auto [x0, x1] = column_x(bladder_column(k), c.width, c.bladder_width);
     const double z0 = k <= 4 ? z_upper : 0.0, z1 = z0 + hb;
@@ -328,9 +334,11 @@ Mesh build_robot_physical(const ParamSet& params) {
     a.pieces.push_back({axis_box(x0, x1, y0, y1, z1 - w, z1), name});
     a.pieces.push_back({axis_box(x0, x0 + w, y0, y1, z0 + w, z1 - w), name});
     a.pieces.push_back({axis_box(x1 - w, x1, y0, y1, z0 + w, z1 - w), name});
-    a.pieces.push_back({axis_box(x0 + w, x1 - w, y0, y0 + w, z0 + w, z1 - w), name});
-    a.pieces.push_back({axis_box(x0 + w, x1 - w, y1 - w, y1, z0 + w, z1 - w), name});
-    a.cavities.push_back({axis_box(x0 + w, x1 - w, y0 + w, y1 - w, z0 + w, z1 - w), name + "_wall"});
+    if (end_walls) {
+      a.pieces.push_back({axis_box(x0 + w, x1 - w, y0, y0 + w, z0 + w, z1 - w), name});
+      a.pieces.push_back({axis_box(x0 + w, x1 - w, y1 - w, y1, z0 + w, z1 - w), name});
+    }
+    a.cavities.push_back({axis_box(x0 + w, x1 - w, y0 + we, y1 - we, z0 + w, z1 - w), name + "_wall"});
   }
   return mesh_assembly(a, c.mesh_size, c.order,
                        params.context().empty() ? "geometry robot_physical" : params.context());

@@ -37,7 +37,8 @@
 //   mid-thickness of each skin layer), core_gap 0.001, edge_width 0.005, end_seal 0.005,
 //   bladder_thickness 0.003, bladder_wall 0.0008 (DS30 wall around each chamber),
 //   bladder_width 0.02, foot_length 0.02 (bladders span y in [foot_length,
-//   length - foot_length]).
+//   length - foot_length]), bladder_end_walls 1 (0: chambers open at both ends, as
+//   sleeves along y, e.g. through a whole plane-strain slice with foot_length 0).
 //   Volumes: skin (DS10: both layers without the fabric, the bonding strips), fabric,
 //   bladder_1 .. bladder_8 (DS30 chamber walls).
 //   Surfaces: core_wall, bladder_1_wall .. bladder_8_wall (closed chamber cavities),

@@ -268,4 +268,15 @@ TEST(Scene, OpenSleeveAndWeightlessKeys) {
   EXPECT_NE(e.find("needs growth actuation"), std::string::npos) << e;
   e = error_of(std::string(kGood) + replace(actuation, "KEY", "core_open_axis: y"));
   EXPECT_NE(e.find("actuation.core_open_axis"), std::string::npos) << e;
+  {  // chambers without end walls: every bladder cavity an open sleeve
+    TempScene s(std::string(kGood) + replace(actuation, "KEY", "bladders_open_axis: y"));
+    const Scene scene = read_scene(s.file.string());
+    ASSERT_EQ(scene.cavities.size(), 1u);
+    EXPECT_EQ(scene.cavities[0].open_axis, 1);
+    EXPECT_EQ(scene.cavities[0].axes, (std::array<bool, 3>{true, false, true}));
+  }
+  e = error_of(std::string(kGood) + replace(actuation, "KEY", "bladders_open_axis: q"));
+  EXPECT_NE(e.find("actuation.bladders_open_axis"), std::string::npos) << e;
+  e = error_of(std::string(kGood) + "actuation: {schedule: " + schedule + ", core: zmax, bladders_open_axis: y}\n");
+  EXPECT_NE(e.find("needs 'bladders'"), std::string::npos) << e;
 }

@@ -197,7 +197,7 @@ TEST(ScheduleFile, ErrorsNameFileLineAndKey) {
   EXPECT_NE(e.find("bad.yaml:2:11: column_s"), std::string::npos) << e;
   EXPECT_NE(e.find("expected a number, got 'fast'"), std::string::npos) << e;
 
-  e = expect_error(head + "core_pressure_pa: 20000\n" + rows(10, "01"));
+  e = expect_error(head + "core_pressure_pa: -200000\n" + rows(10, "01"));  // below vacuum
   EXPECT_NE(e.find("core_pressure_pa"), std::string::npos) << e;
   EXPECT_NE(e.find("outside the allowed range"), std::string::npos) << e;
 

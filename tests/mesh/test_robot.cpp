@@ -289,6 +289,41 @@ TEST(RobotGeometry, OpenEndedCore) {
   EXPECT_THROW(build_geometry(robot_params("robot_voxel", {{"mesh_size", 0.03}, {"end_seal", -0.01}})), InputError);
 }
 
+// A plane-strain slice of the physical laminate: no feet (foot_length 0) and chambers
+// without end walls (bladder_end_walls 0) running through the slice as open sleeves.
+// Each chamber wall is then the chamber's floor, roof and sides only (area exact, no
+// face normal along y), the DS30 walls lose their end caps, and there are no feet.
+TEST(RobotGeometry, PhysicalSliceWithOpenChambers) {
+  const double W = 0.10, L = 0.006, t = 0.003, tf = 0.0005, g = 0.001, e = 0.005, hb = 0.003, w = 0.0008, bw = 0.02;
+  const Mesh mesh = build_geometry(robot_params(
+      "robot_physical",
+      {{"mesh_size", 0.003}, {"length", L}, {"end_seal", 0.0}, {"foot_length", 0.0}, {"bladder_end_walls", 0}}));
+  const auto names = mesh.region_names(2);
+  EXPECT_EQ(std::count(names.begin(), names.end(), "foot_a"), 0);
+  EXPECT_EQ(std::count(names.begin(), names.end(), "foot_b"), 0);
+  const double bladder = (bw * hb - (bw - 2 * w) * (hb - 2 * w)) * L;
+  for (int k = 1; k <= 8; ++k) {
+    const std::string name = "bladder_" + std::to_string(k);
+    EXPECT_NEAR(region_volume(mesh, name), bladder, 1e-10 * bladder) << k;
+    EXPECT_NEAR(area(mesh, name + "_wall"), 2 * ((bw - 2 * w) + (hb - 2 * w)) * L, 1e-12) << k;
+    for (int f : mesh.faces_of(name + "_wall"))
+      EXPECT_LT(std::abs(face_area_normal(mesh, f).normalized().y()), 1e-12) << k;
+  }
+  const double skin = 2 * W * L * (t - tf) + 2 * e * L * g;
+  EXPECT_NEAR(region_volume(mesh, "skin"), skin, 1e-10 * skin);
+  EXPECT_NEAR(area(mesh, "bottom"), W * L, 1e-12);
+  // With end walls the chambers need room for them along the slice (2 x 0.8 mm).
+  try {
+    build_geometry(robot_params("robot_physical",
+                                {{"mesh_size", 0.003}, {"length", 0.0015}, {"end_seal", 0.0}, {"foot_length", 0.0}}));
+    ADD_FAILURE() << "a 1.5 mm slice with chamber end walls was accepted";
+  } catch (const InputError& err) {
+    EXPECT_NE(std::string(err.what()).find("bladder_wall"), std::string::npos) << err.what();
+  }
+  EXPECT_THROW(build_geometry(robot_params("robot_physical", {{"mesh_size", 0.003}, {"bladder_end_walls", 2}})),
+               InputError);
+}
+
 TEST(RobotGeometry, PhysicalPresetP2) {
   const Mesh mesh = build_geometry(robot_params("robot_physical", {{"mesh_size", 0.03}, {"order", 2}}));
   EXPECT_EQ(mesh.order, 2);
