@@ -55,6 +55,7 @@
 //   actuation:                                  # a schedule file shared with `morphfem hw play`
 //     {schedule: schedules/rolling.yaml, start: 1.0,      # gait time 0 at t = start [s]
 //      bladders: {b1: bladder_1_wall, ...},               # channel -> cavity wall surface
+//      bladders_open_axis: y,                             # chambers without end walls: open sleeves
 //      core: core_wall, volume_axes: [x, y, z], core_open_axis: y,   # (open sleeve core)
 //      feet: {foot_a: foot_a, foot_b: foot_b, mu_active: 2.0, mu_inactive: 1.0e-4}}
 //     # schedule: a file, or the schedule itself inline (a mapping in the schedule file format)
