@@ -31,10 +31,13 @@ std::string source_dir() { return MORPHFEM_SOURCE_DIR; }
 
 const char* kRobotUsage =
     "usage: morphfem robot COMMAND [options]\n"
-    "  validate [--fidelity L] [--cases A,B,...] [--out DIR] [--set KEY=VALUE ...]\n"
+    "  validate [--fidelity L] [--cases A,B,...] [--presets voxel,physical] [--out DIR]\n"
+    "           [--set KEY=VALUE ...] [--set-physical KEY=VALUE ...]\n"
     "        the voxel study's baselines (hand-designed rolling and inching, flat and\n"
     "        15 deg hill, four empty schedules): voxel speed beside the finite-element\n"
-    "        speed (voxel-study preset, growth actuation), wall time, dofs, steps\n"
+    "        speed (voxel-study preset, growth actuation; --set keys, level L), wall time,\n"
+    "        dofs, steps, and beside the physical laminate with pressure actuation where\n"
+    "        its rolling slice applies (examples/physical/roll_slice.yaml; --set-physical)\n"
     "  ladder --case NAME [--levels 0,1,2] [--out DIR]\n"
     "        one case on several fidelity levels: speed against wall time, and the\n"
     "        cheapest level within 5 % of the finest\n"
@@ -125,6 +128,17 @@ std::vector<RobotCase> voxel_baseline_cases(const std::string& dir) {
   };
 }
 
+std::vector<RobotCase> physical_baseline_cases(const std::string& dir) {
+  std::vector<RobotCase> out;
+  for (RobotCase c : voxel_baseline_cases(dir)) {
+    if (!(c.schedule.core_pressure_pa > 0) || c.schedule.orientation_deg != 0) continue;
+    c.template_scene = dir + "/examples/physical/roll_slice.yaml";
+    c.physical = true;
+    out.push_back(c);
+  }
+  return out;
+}
+
 namespace {
 
 void set_path(YAML::Node node, const std::vector<std::string>& path, size_t i, const YAML::Node& value,
@@ -174,7 +188,43 @@ void set_scene_key(YAML::Node root, const std::string& assignment, const std::st
   set_path(root, path, 0, value, where, key);
 }
 
+namespace {
+
+// A physical case: the template's own schedule with the case's matrix, orientation,
+// column length and repeats; an uninflated case leaves the core at 0.
+YAML::Node physical_scene_yaml(const RobotCase& c, const std::string& output_dir) {
+  YAML::Node root = load_scene_yaml(c.template_scene);
+  YAML::Node a = root["actuation"];
+  if (!a || !a.IsMap() || !a["schedule"] || !a["schedule"].IsMap() || !a["start"])
+    throw InputError(c.template_scene, "a physical robot template needs 'actuation' with an inline schedule and start");
+  root["name"] = c.name;
+  YAML::Node sched = a["schedule"];
+  YAML::Node matrix(YAML::NodeType::Sequence);
+  for (int row = 0; row < kNumRows; ++row) {
+    std::string text;
+    for (int k = 0; k < c.schedule.columns(); ++k) text += c.schedule.active(row, k) ? '1' : '0';
+    matrix.push_back(text);
+  }
+  sched["matrix"] = matrix;
+  sched["orientation_deg"] = c.schedule.orientation_deg;
+  sched["column_s"] = c.schedule.column_s;
+  sched["repeats"] = c.schedule.repeats;
+  if (!(c.schedule.core_pressure_pa > 0)) sched["core_pressure_pa"] = 0;
+  root["environment"]["slope_deg"] = c.slope_deg;
+  root["environment"]["heading_deg"] = c.schedule.orientation_deg;
+  root["solver"]["end_time"] = a["start"].as<double>() + c.schedule.duration() + 1e-6;
+  if (output_dir.empty())
+    root.remove("output");
+  else
+    root["output"]["directory"] = output_dir;
+  for (const std::string& assignment : c.overrides) set_scene_key(root, assignment, c.template_scene);
+  return root;
+}
+
+}  // namespace
+
 YAML::Node robot_scene_yaml(const RobotCase& c, const RobotFidelity& level, const std::string& output_dir) {
+  if (c.physical) return physical_scene_yaml(c, output_dir);
   YAML::Node root = load_scene_yaml(c.template_scene);
   YAML::Node a = root["actuation"];
   if (!a || !a.IsMap() || !a["growth"])
@@ -258,7 +308,8 @@ std::vector<CaseOutcome> run_jobs(const std::vector<std::pair<RobotCase, RobotFi
   int done_here = 0;
   for (int j = rank; j < n; j += size) {
     const auto& [c, level] = jobs[j];
-    const std::string dir = out_dir.empty() ? "" : out_dir + "/" + c.name + "_L" + level.name;
+    const std::string dir =
+        out_dir.empty() ? "" : out_dir + "/" + c.name + (c.physical ? "_physical" : "_L" + level.name);
     const SimulationResult r = run_robot_case(c, level, dir, PETSC_COMM_SELF, false);
     const double values[CaseOutcome::kFields] = {r.speed_bl_per_s,
                                                  r.gait_displacement_m,
@@ -342,42 +393,91 @@ Json outcome_json(const RobotCase& c, const RobotFidelity& level, const CaseOutc
 }
 
 int validate(const std::vector<std::string>& args, MPI_Comm comm) {
-  check_options(args, {"--fidelity", "--cases", "--out", "--set"});
+  check_options(args, {"--fidelity", "--cases", "--out", "--set", "--set-physical", "--presets"});
   const RobotFidelity& level = find_robot_fidelity(option(args, "--fidelity", "0"));
   const std::string out_dir = option(args, "--out", "results/robot/validate");
+  bool voxel = false, physical = false;
+  for (const auto& p : split(option(args, "--presets", "voxel,physical"))) {
+    if (p != "voxel" && p != "physical")
+      throw InputError("--presets", "unknown preset '" + p + "' (known: voxel, physical)");
+    (p == "voxel" ? voxel : physical) = true;
+  }
   auto all_cases = voxel_baseline_cases(source_dir());
   for (auto& c : all_cases) c.overrides = options(args, "--set");
-  std::vector<std::pair<RobotCase, RobotFidelity>> jobs;
+  auto physical_cases = physical_baseline_cases(source_dir());
+  for (auto& c : physical_cases) c.overrides = options(args, "--set-physical");
+  std::vector<std::string> names;
   const std::string wanted = option(args, "--cases", "");
-  if (wanted.empty())
-    for (const auto& c : all_cases) jobs.emplace_back(c, level);
-  else
-    for (const auto& name : split(wanted)) jobs.emplace_back(find_case(all_cases, name), level);
+  for (const auto& c : all_cases) names.push_back(c.name);
+  if (!wanted.empty()) {
+    names = split(wanted);
+    for (const auto& name : names) find_case(all_cases, name);  // refuses unknown names
+  }
+  // The voxel-preset jobs, then the physical ones; each row of the table pairs them by name.
+  std::vector<std::pair<RobotCase, RobotFidelity>> jobs;
+  for (const auto& name : names)
+    if (voxel) jobs.emplace_back(find_case(all_cases, name), level);
+  for (const auto& name : names)
+    for (const auto& c : physical_cases)
+      if (physical && c.name == name) jobs.emplace_back(c, level);
   const auto outcomes = run_jobs(jobs, out_dir, comm);
   int rank = 0;
   MPI_Comm_rank(comm, &rank);
   if (rank != 0) return 0;
   std::string table =
       "case                       slope  orient  core_Pa   voxel_BL/s      fem_BL/s   wall_s   dofs  "
-      "steps  newton  status\n";
+      "steps  newton  status   phys_BL/s  phys_wall_s\n";
   std::vector<Json> rows;
-  char line[256];
-  for (size_t j = 0; j < jobs.size(); ++j) {
-    const auto& c = jobs[j].first;
-    const auto& o = outcomes[j];
-    std::snprintf(line, sizeof line, "%-26s %5.1f  %6.1f  %7.0f  %+11.5f  %+11.5f  %7.1f  %5.0f  %5.0f  %6.0f  %s\n",
-                  c.name.c_str(), c.slope_deg, c.schedule.orientation_deg, c.schedule.core_pressure_pa,
-                  c.voxel_bl_per_s, o.speed, o.wall_s, o.dofs, o.steps, o.newton, o.completed > 0 ? "ok" : "FAILED");
+  char line[320];
+  auto find_job = [&](const std::string& name, bool phys) -> int {
+    for (size_t j = 0; j < jobs.size(); ++j)
+      if (jobs[j].first.name == name && jobs[j].first.physical == phys) return static_cast<int>(j);
+    return -1;
+  };
+  for (const auto& name : names) {
+    const int jv = find_job(name, false), jp = find_job(name, true);
+    const RobotCase& c = jv >= 0 ? jobs[jv].first : find_case(all_cases, name);
+    std::string fem = "          -  ", phys = "        n/a          -";
+    if (jv >= 0) {
+      const auto& o = outcomes[jv];
+      char buf[160];
+      std::snprintf(buf, sizeof buf, "%+11.5f  %7.1f  %5.0f  %5.0f  %6.0f  %-6s", o.speed, o.wall_s, o.dofs, o.steps,
+                    o.newton, o.completed > 0 ? "ok" : "FAILED");
+      fem = buf;
+      rows.push_back(outcome_json(c, level, o));
+    } else {
+      fem = "          -        -      -      -       -  -     ";
+    }
+    if (jp >= 0) {
+      const auto& o = outcomes[jp];
+      char buf[96];
+      std::snprintf(buf, sizeof buf, "%+11.5f  %11.1f%s", o.speed, o.wall_s, o.completed > 0 ? "" : " FAILED");
+      phys = buf;
+      Json j = outcome_json(jobs[jp].first, level, o);
+      j.add("preset", "physical").add("template", jobs[jp].first.template_scene);
+      rows.push_back(j);
+    }
+    std::snprintf(line, sizeof line, "%-26s %5.1f  %6.1f  %7.0f  %+11.5f  %s  %s\n", c.name.c_str(), c.slope_deg,
+                  c.schedule.orientation_deg, c.schedule.core_pressure_pa, c.voxel_bl_per_s, fem.c_str(), phys.c_str());
     table += line;
-    rows.push_back(outcome_json(c, level, o));
   }
+  table +=
+      "phys: the physical laminate's plane-strain rolling slice (examples/physical/roll_slice.yaml: core at the\n"
+      "50 kPa line pressure, chambers at the schedule's pressure); n/a: a cross-section cannot inch or move along\n"
+      "the body (heading 90 deg).\n";
   std::printf("fidelity %s: mesh %.4g m, P%d, max step %.4g s\n%s", level.name.c_str(), level.mesh_size, level.order,
               level.max_step, table.c_str());
   std::filesystem::create_directories(out_dir);
   Json summary;
   std::string overrides;  // the --set assignments, as given
   for (const auto& assignment : options(args, "--set")) overrides += (overrides.empty() ? "" : "; ") + assignment;
-  summary.add("fidelity", level.name).add("overrides", overrides).add("cases", rows);
+  std::string physical_overrides;
+  for (const auto& assignment : options(args, "--set-physical"))
+    physical_overrides += (physical_overrides.empty() ? "" : "; ") + assignment;
+  summary.add("fidelity", level.name)
+      .add("overrides", overrides)
+      .add("physical_overrides", physical_overrides)
+      .add("cases", rows);
   write_file_atomic(out_dir + "/validation.json", summary.str(true) + "\n");
   write_file_atomic(out_dir + "/validation.txt", table);
   std::printf("results: %s/validation.json, per case %s/CASE_L%s/\n", out_dir.c_str(), out_dir.c_str(),

@@ -54,6 +54,11 @@ struct RobotCase {
   double mu_foot_inactive = std::numeric_limits<double>::quiet_NaN();
   // Scene keys set last, "a.b.c=VALUE" (see set_scene_key), e.g. for a diagnostic run.
   std::vector<std::string> overrides = {};
+  // The physical preset with pressure actuation (template examples/physical/roll_slice.yaml):
+  // the case's matrix, orientation, column length and repeats go into the template's
+  // schedule, which keeps its pressures (chambers, core line pressure) and its timing;
+  // the fidelity level leaves the template's mesh and time step alone.
+  bool physical = false;
 };
 
 // Sets one key of a scene document from "a.b.c=VALUE" (VALUE in YAML; a path segment
@@ -65,6 +70,12 @@ void set_scene_key(YAML::Node root, const std::string& assignment, const std::st
 // inching (90 deg, 0 kPa) gaits on flat ground and on the 15 deg hill, and the four
 // empty schedules. `source_dir` is the repository (templates in examples/voxel/).
 std::vector<RobotCase> voxel_baseline_cases(const std::string& source_dir);
+
+// The baseline cases the physical laminate's rolling slice can play: those with the
+// robot inflated (core > 0) and heading 0 (a plane-strain cross-section cannot move
+// along the body), i.e. roll_flat, roll_hill15 and empty_0deg_12kPa_flat, with the
+// inflated core at the template's line pressure (50 kPa) instead of 12 kPa.
+std::vector<RobotCase> physical_baseline_cases(const std::string& source_dir);
 
 // The schedule of a case as the lattice plays it: the voxel study's column length,
 // two repeats.

@@ -63,6 +63,39 @@ TEST(RobotStudy, CaseSetsScheduleSlopeHeadingAndFidelityInTheTemplate) {
   EXPECT_THROW(find_robot_fidelity("9"), InputError);
 }
 
+// The physical laminate's cases: only the inflated, heading-0 baselines (a plane-strain
+// cross-section can roll but not inch); the template keeps its pressures, mesh and
+// time step, the case sets matrix, timing, slope and heading.
+TEST(RobotStudy, PhysicalCasesPlayTheBaselineScheduleOnTheRollingSlice) {
+  const auto cases = physical_baseline_cases(MORPHFEM_SOURCE_DIR);
+  std::vector<std::string> names;
+  for (const auto& c : cases) names.push_back(c.name);
+  EXPECT_EQ(names, (std::vector<std::string>{"roll_flat", "roll_hill15", "empty_0deg_12kPa_flat"}));
+  const RobotCase& hill = cases[1];
+  ASSERT_TRUE(hill.physical);
+  const YAML::Node doc = robot_scene_yaml(hill, find_robot_fidelity("2"), "");
+  EXPECT_EQ(doc["geometry"]["mesh_size"].as<double>(), 0.003);  // the template's, not level 2's
+  EXPECT_EQ(doc["solver"]["max_step"].as<double>(), 0.05);
+  const Scene scene = scene_from_yaml(doc, hill.template_scene);
+  ASSERT_TRUE(scene.gait.enabled);
+  EXPECT_NEAR(scene.gait.end - scene.gait.start, 16 * hill.schedule.column_s, 1e-8);
+  EXPECT_LE(scene.gait.end, scene.solver.t_end);
+  EXPECT_NEAR(scene.gravity.x(), -9.80665 * std::sin(15 * M_PI / 180), 1e-9);  // uphill along +x
+  // Chamber 8 is on in column 1 at the template's 25 kPa; the core at the 50 kPa line pressure.
+  const CavitySpec* b8 = nullptr;
+  const CavitySpec* core = nullptr;
+  for (const auto& cav : scene.cavities) {
+    if (cav.name == "b8") b8 = &cav;
+    if (cav.name == "core") core = &cav;
+  }
+  ASSERT_TRUE(b8 && core);
+  const double t1 = scene.gait.start + 0.5 * hill.schedule.column_s, t2 = t1 + hill.schedule.column_s;
+  EXPECT_NEAR(b8->pressure(t1), 25000, 1e-6);
+  EXPECT_NEAR(b8->pressure(t2), 0, 1e-6);
+  EXPECT_NEAR(core->pressure(t1), 50000, 1e-6);
+  EXPECT_EQ(b8->open_axis, 1);
+}
+
 // --set: keys set last, '*' over a mapping's keys, a new last key; bad paths and
 // assignments are refused with the path named.
 TEST(RobotStudy, OverridesSetSceneKeysLast) {
