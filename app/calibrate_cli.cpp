@@ -47,8 +47,8 @@ const char* kCalibrateUsage =
     "        [--height-m 0.012] [--fraction 0.9] [--tolerance 0.02] [--max-runs 5] [--out DIR]\n"
     "        [--set KEY=VALUE]...\n"
     "        the core valve's supply and vacuum conductances so the morph scene (default\n"
-    "        examples/physical/morph_valve_slice.yaml) turns flat -> cylinder and back in the\n"
-    "        measured times; inflated diameter and flat height against the measured ones;\n"
+    "        examples/physical/morph_valve_vacuum_slice.yaml) turns flat -> cylinder and back in\n"
+    "        the measured times; inflated diameter and flat height against the measured ones;\n"
     "        calibration file\n";
 
 std::string plot_script() { return std::string(MORPHFEM_SOURCE_DIR) + "/scripts/plot_calibration.py"; }

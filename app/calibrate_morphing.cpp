@@ -5,7 +5,7 @@
 // model's predictions beside their measured values. Measures and the conductance
 // update: optim/morph_fit.h.
 //
-// The scene (default examples/physical/morph_valve_slice.yaml) has one gas cavity,
+// The scene (default examples/physical/morph_valve_vacuum_slice.yaml) has one gas cavity,
 // the core, whose supply pressure turns positive (the line) and later negative (the
 // vacuum pump). Each run sets the cavity's `conductance` and `vacuum_conductance`,
 // runs the scene, samples the mid-length cross-section after every step and
@@ -31,7 +31,7 @@ namespace morphfem {
 namespace {
 
 struct MorphingOptions {
-  std::string scene = std::string(MORPHFEM_SOURCE_DIR) + "/examples/physical/morph_valve_slice.yaml";
+  std::string scene = std::string(MORPHFEM_SOURCE_DIR) + "/examples/physical/morph_valve_vacuum_slice.yaml";
   std::string out = "results/calibrate/morphing";
   std::vector<std::string> sets;
   double inflate_s = 11.5, deflate_s = 4.7, diameter_m = 0.07, height_m = 0.012;

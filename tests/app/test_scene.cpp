@@ -156,6 +156,19 @@ TEST(Scene, EveryExampleSceneRuns) {
   EXPECT_GE(count, 3);
 }
 
+// The robot scenes (examples/voxel, examples/physical) are too big to run in the suite,
+// but every one must read: keys, schedules, calibration files they load.
+TEST(Scene, EveryRobotSceneReads) {
+  int count = 0;
+  for (const char* folder : {"voxel", "physical"})
+    for (const auto& entry : fs::directory_iterator(fs::path(MORPHFEM_SOURCE_DIR) / "examples" / folder)) {
+      if (entry.path().extension() != ".yaml") continue;
+      EXPECT_NO_THROW(read_scene(entry.path().string())) << entry.path();
+      ++count;
+    }
+  EXPECT_GE(count, 10);
+}
+
 TEST(Scene, GasCavityFillsTowardsTheSupplyPressure) {
   Scene scene = read_scene(std::string(MORPHFEM_SOURCE_DIR) + "/examples/balloon_valve.yaml");
   std::vector<double> pressure;
