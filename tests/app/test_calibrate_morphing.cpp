@@ -90,6 +90,43 @@ TEST(CalibrateMorphing, ValveConductanceLandsOnTheTargetTime) {
   std::filesystem::remove_all(dir);
 }
 
+// Both halves: the supply turns negative at t = 3 s (the "vacuum" phase), so the fit
+// sets the supply and the vacuum conductance together, each from its own phase time.
+TEST(CalibrateMorphing, SupplyAndVacuumConductancesLandOnBothTimes) {
+  int rank = 0;
+  MPI_Comm_rank(PETSC_COMM_WORLD, &rank);
+  const auto dir = temp_dir("morphfem_calibrate_morphing_cycle");
+  const std::string scene =
+      balloon_scene(dir,
+                    "  gas_cavities:\n"
+                    "    - {name: core, surfaces: [inner], symmetry_factor: 8,\n"
+                    "       supply_pressure: [[0, 0], [0.1, 0], [0.11, 6000], [3.0, 6000], [3.01, -1000]],\n"
+                    "       conductance: 8.0e-8, vacuum_conductance: 8.0e-8}\n");
+  const std::string out = (dir / "fit").string();
+  const int status = calibrate_morphing_main({"--scene", scene, "--out", out, "--inflate-s", "0.6", "--deflate-s",
+                                              "0.3", "--tolerance", "0.02", "--max-runs", "5"},
+                                             PETSC_COMM_WORLD);
+  ASSERT_EQ(status, 0) << "the fit must converge";
+  if (rank != 0) return;
+  const Calibration c = read_calibration_file(out + "/morphing.yaml");
+  EXPECT_NE(c.parameter("conductance_supply").value, 8.0e-8);
+  EXPECT_NE(c.parameter("conductance_vacuum").value, 8.0e-8);
+  EXPECT_NEAR(std::stod(c.fit.at("inflate_time_s")), 0.6, 0.02 * 0.6);
+  EXPECT_NEAR(std::stod(c.fit.at("deflate_time_s")), 0.3, 0.02 * 0.3);
+  // A scene takes both values from the file.
+  const std::string loaded =
+      balloon_scene(dir,
+                    "  gas_cavities:\n"
+                    "    - {name: core, surfaces: [inner], symmetry_factor: 8, supply_pressure: [[0, 1000], [1, 1000], "
+                    "[1.01, -1000]],\n"
+                    "       conductance: {calibration: fit/morphing.yaml, parameter: conductance_supply},\n"
+                    "       vacuum_conductance: {calibration: fit/morphing.yaml, parameter: conductance_vacuum}}\n");
+  const Scene s = read_scene(loaded);
+  EXPECT_DOUBLE_EQ(s.gas_cavities.at(0).conductance_at(0.5), c.parameter("conductance_supply").value);
+  EXPECT_DOUBLE_EQ(s.gas_cavities.at(0).conductance_at(1.5), c.parameter("conductance_vacuum").value);
+  std::filesystem::remove_all(dir);
+}
+
 TEST(CalibrateMorphing, RefusesScenesWithoutAGasCavity) {
   const auto dir = temp_dir("morphfem_calibrate_morphing_bad");
   const std::string scene = balloon_scene(dir,
