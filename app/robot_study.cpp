@@ -480,8 +480,8 @@ int validate(const std::vector<std::string>& args, MPI_Comm comm) {
       .add("cases", rows);
   write_file_atomic(out_dir + "/validation.json", summary.str(true) + "\n");
   write_file_atomic(out_dir + "/validation.txt", table);
-  std::printf("results: %s/validation.json, per case %s/CASE_L%s/\n", out_dir.c_str(), out_dir.c_str(),
-              level.name.c_str());
+  std::printf("results: %s/validation.json, per case %s/CASE_L%s/ (physical: CASE_physical/)\n", out_dir.c_str(),
+              out_dir.c_str(), level.name.c_str());
   return 0;
 }
 
