@@ -190,6 +190,20 @@ void set_scene_key(YAML::Node root, const std::string& assignment, const std::st
 
 namespace {
 
+// The keys every case sets last: slope, heading (the schedule's orientation), the
+// end time (just after the gait's end), the output folder, then the overrides.
+YAML::Node finish_case_yaml(YAML::Node root, const RobotCase& c, double gait_end_s, const std::string& output_dir) {
+  root["environment"]["slope_deg"] = c.slope_deg;
+  root["environment"]["heading_deg"] = c.schedule.orientation_deg;
+  root["solver"]["end_time"] = gait_end_s + 1e-6;
+  if (output_dir.empty())
+    root.remove("output");
+  else
+    root["output"]["directory"] = output_dir;
+  for (const std::string& assignment : c.overrides) set_scene_key(root, assignment, c.template_scene);
+  return root;
+}
+
 // A physical case: the template's own schedule with the case's matrix, orientation,
 // column length and repeats; an uninflated case leaves the core at 0.
 YAML::Node physical_scene_yaml(const RobotCase& c, const std::string& output_dir) {
@@ -210,15 +224,7 @@ YAML::Node physical_scene_yaml(const RobotCase& c, const std::string& output_dir
   sched["column_s"] = c.schedule.column_s;
   sched["repeats"] = c.schedule.repeats;
   if (!(c.schedule.core_pressure_pa > 0)) sched["core_pressure_pa"] = 0;
-  root["environment"]["slope_deg"] = c.slope_deg;
-  root["environment"]["heading_deg"] = c.schedule.orientation_deg;
-  root["solver"]["end_time"] = a["start"].as<double>() + c.schedule.duration() + 1e-6;
-  if (output_dir.empty())
-    root.remove("output");
-  else
-    root["output"]["directory"] = output_dir;
-  for (const std::string& assignment : c.overrides) set_scene_key(root, assignment, c.template_scene);
-  return root;
+  return finish_case_yaml(root, c, a["start"].as<double>() + c.schedule.duration(), output_dir);
 }
 
 }  // namespace
@@ -235,19 +241,10 @@ YAML::Node robot_scene_yaml(const RobotCase& c, const RobotFidelity& level, cons
   a["core_ramp_s"] = kCoreRamp;
   if (!std::isnan(c.mu_foot_active)) a["feet"]["mu_active"] = c.mu_foot_active;
   if (!std::isnan(c.mu_foot_inactive)) a["feet"]["mu_inactive"] = c.mu_foot_inactive;
-  root["environment"]["slope_deg"] = c.slope_deg;
-  root["environment"]["heading_deg"] = c.schedule.orientation_deg;
   root["geometry"]["mesh_size"] = level.mesh_size;
   root["geometry"]["order"] = level.order;
-  const double gait_s = voxel_timeline(c.schedule).duration();
-  root["solver"]["end_time"] = kSettleStart + gait_s + 1e-6;
   root["solver"]["max_step"] = level.max_step;
-  if (output_dir.empty())
-    root.remove("output");
-  else
-    root["output"]["directory"] = output_dir;
-  for (const std::string& assignment : c.overrides) set_scene_key(root, assignment, c.template_scene);
-  return root;
+  return finish_case_yaml(root, c, kSettleStart + voxel_timeline(c.schedule).duration(), output_dir);
 }
 
 SimulationResult run_robot_case(const RobotCase& c, const RobotFidelity& level, const std::string& output_dir,
@@ -437,7 +434,7 @@ int validate(const std::vector<std::string>& args, MPI_Comm comm) {
   for (const auto& name : names) {
     const int jv = find_job(name, false), jp = find_job(name, true);
     const RobotCase& c = jv >= 0 ? jobs[jv].first : find_case(all_cases, name);
-    std::string fem = "          -  ", phys = "        n/a          -";
+    std::string fem = "          -        -      -      -       -  -     ", phys = "        n/a          -";
     if (jv >= 0) {
       const auto& o = outcomes[jv];
       char buf[160];
@@ -445,8 +442,6 @@ int validate(const std::vector<std::string>& args, MPI_Comm comm) {
                     o.newton, o.completed > 0 ? "ok" : "FAILED");
       fem = buf;
       rows.push_back(outcome_json(c, level, o));
-    } else {
-      fem = "          -        -      -      -       -  -     ";
     }
     if (jp >= 0) {
       const auto& o = outcomes[jp];
