@@ -526,12 +526,19 @@ Scene scene_from_yaml(const YAML::Node& root, const std::string& path) {
     }
     std::array<bool, 3> axes{true, true, true};
     if (a["volume_axes"]) axes = r.axes(a["volume_axes"], key + ".volume_axes");
-    auto add_cavity = [&](int channel, const std::string& surface) {
+    // A channel's cavity; with actuation.<open_key> an open sleeve along that axis (its
+    // volume axes the other two, whatever volume_axes says).
+    auto add_cavity = [&](int channel, const std::string& surface, const char* open_key) {
       CavitySpec spec;
       spec.name = channel_name(channel);
       spec.surfaces = {surface};
       spec.axes = axes;
       spec.pressure = channel_pressure(*schedule, channel, start);
+      if (a[open_key]) {
+        YAML::Node sleeve;
+        sleeve["open_axis"] = a[open_key];
+        r.open_axis(sleeve, key + "." + open_key, spec.axes, spec.open_axis);
+      }
       scene.cavities.push_back(spec);
     };
     if (const auto b = a["bladders"]) {
@@ -541,23 +548,14 @@ Scene scene_from_yaml(const YAML::Node& root, const std::string& path) {
         const int channel = channel_index(name);
         if (channel < 0 || channel >= kNumBladders)
           r.fail(kv.first, key + ".bladders." + name, "not a bladder channel (b1..b8)");
-        add_cavity(channel, r.text(kv.second, key + ".bladders." + name));
-        if (a["bladders_open_axis"]) {  // chambers without end walls (a plane-strain slice): open sleeves
-          YAML::Node sleeve;
-          sleeve["open_axis"] = a["bladders_open_axis"];
-          r.open_axis(sleeve, key + ".bladders_open_axis", scene.cavities.back().axes, scene.cavities.back().open_axis);
-        }
+        // bladders_open_axis: chambers without end walls (a plane-strain slice)
+        add_cavity(channel, r.text(kv.second, key + ".bladders." + name), "bladders_open_axis");
       }
     } else if (a["bladders_open_axis"]) {
       r.fail(a["bladders_open_axis"], key + ".bladders_open_axis", "needs 'bladders'");
     }
     if (a["core"]) {
-      add_cavity(kChannelCore, r.text(a["core"], key + ".core"));
-      if (a["core_open_axis"]) {  // an open sleeve: its own axes (the other two), whatever volume_axes says
-        YAML::Node sleeve;
-        sleeve["open_axis"] = a["core_open_axis"];
-        r.open_axis(sleeve, key + ".core", scene.cavities.back().axes, scene.cavities.back().open_axis);
-      }
+      add_cavity(kChannelCore, r.text(a["core"], key + ".core"), "core_open_axis");
       if (a["core_ramp_s"]) {  // the core rises linearly from 0 over [0, core_ramp_s], then holds
         const double ramp = r.number(a["core_ramp_s"], key + ".core_ramp_s");
         if (!(ramp > 0) || ramp > start) r.fail(a["core_ramp_s"], key + ".core_ramp_s", "must be in (0, start]");
