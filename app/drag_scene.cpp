@@ -63,25 +63,34 @@ Scene drag_scene(const DragParameters& p) {
   return s;
 }
 
-DragCurve run_drag_test(const DragParameters& p, MPI_Comm comm) {
-  const Scene scene = drag_scene(p);
+DragCurve run_pull_scene(const Scene& scene, MPI_Comm comm, RunOptions options, double time_scale) {
+  if (scene.pulls.empty()) throw InputError(scene.source, "the scene has no loads.pulls (a test machine to record)");
   DragCurve curve;
+  const double start = scene.pulls.front().start;
   std::unique_ptr<PullSpringTerm> spring;  // on the solved mesh (the partitioner renumbers nodes)
-  RunOptions options;
-  options.write_output = false;
-  options.progress = false;
-  options.on_step = [&](double t, const Mesh& mesh, const RowMatrixXd& u, const SimulationResult&) {
+  auto chained = options.on_step;
+  options.on_step = [&](double t, const Mesh& mesh, const RowMatrixXd& u, const SimulationResult& r) {
+    if (chained) chained(t, mesh, u, r);
     if (!spring) spring = std::make_unique<PullSpringTerm>(mesh, 1, scene.pulls.front());
-    if (t < p.settle - 1e-12) return;
-    const double travel = p.speed * p.model_speed_factor * (t - p.settle);
-    curve.time.push_back(travel / p.speed);
-    curve.displacement.push_back(travel);
+    if (t < start - 1e-12) return;
+    curve.time.push_back(time_scale * (t - start));
+    curve.displacement.push_back(spring->crosshead(t) - spring->crosshead(start));
     curve.force.push_back(spring->force(u, t));
   };
   const SimulationResult r = run_scene(scene, comm, options);
   curve.completed = r.stats.completed;
   curve.wall_s = r.stats.wall_s;
+  curve.mass_kg = r.mass_kg;
+  curve.result = r;
   return curve;
+}
+
+DragCurve run_drag_test(const DragParameters& p, MPI_Comm comm) {
+  RunOptions options;
+  options.write_output = false;
+  options.progress = false;
+  // Reported times are crosshead travel / machine speed (the model pulls slower).
+  return run_pull_scene(drag_scene(p), comm, options, p.model_speed_factor);
 }
 
 }  // namespace morphfem

@@ -34,6 +34,7 @@
 #include <vector>
 
 #include "app/scene.h"
+#include "app/simulation.h"
 
 namespace morphfem {
 
@@ -57,7 +58,15 @@ struct DragCurve {
   std::vector<double> force;         // spring (load-cell) force [N]
   bool completed = false;
   double wall_s = 0;
+  double mass_kg = 0;       // of the pulled body
+  SimulationResult result;  // the run (stats, dofs, output folder)
 };
+
+// Runs a scene with a test-machine pull (its first loads.pulls) and records the
+// load-cell force against crosshead travel, one sample per step from the pull's start.
+// Sample times are time_scale x (t - start) (a model pulling at a fraction of the
+// machine's speed reports machine time). InputError if the scene has no pull.
+DragCurve run_pull_scene(const Scene& scene, MPI_Comm comm, RunOptions options = {}, double time_scale = 1.0);
 
 // The drag test as a Scene (built in code; checks the parameters -> InputError).
 Scene drag_scene(const DragParameters& p);

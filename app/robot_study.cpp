@@ -47,6 +47,12 @@ const char* kRobotUsage =
     "  friction-sweep [--fidelity L] [--points all|N] [--out DIR]\n"
     "        inching on flat ground against the feet's mean friction (the voxel study's\n"
     "        sfrict_results.csv: active - inactive = 2.0), beside the voxel points, PNG\n"
+    "  friction-drag [--scene FILE] [--feet inflated,deflated] [--travel-mm D] [--surface wood]\n"
+    "                [--out DIR] [--set KEY=VALUE ...]\n"
+    "        the test-machine pull test (default examples/physical/friction_drag.yaml): the robot\n"
+    "        pulled at the scene's speed with its feet inflated and deflated; force against\n"
+    "        crosshead travel as exports `calibrate pull-tests` reads, their coefficients, PNG\n"
+    "        (foot states spread over the MPI ranks)\n"
     "  benchmark [--fidelity L]\n"
     "        wall time of each hand-designed gait (19.8 s) on one rank, beside the voxel\n"
     "        simulator's 136-145 s on this machine\n"
@@ -56,6 +62,36 @@ const char* kRobotUsage =
     "Cases are spread over the MPI ranks (one rank per case): mpirun -n 2 morphfem robot validate\n";
 
 }  // namespace
+
+std::string option(const std::vector<std::string>& args, const std::string& name, const std::string& fallback) {
+  for (size_t i = 0; i + 1 < args.size(); ++i)
+    if (args[i] == name) return args[i + 1];
+  return fallback;
+}
+
+// Every value of a repeatable option (--set A --set B).
+std::vector<std::string> options(const std::vector<std::string>& args, const std::string& name) {
+  std::vector<std::string> out;
+  for (size_t i = 1; i + 1 < args.size(); i += 2)
+    if (args[i] == name) out.push_back(args[i + 1]);
+  return out;
+}
+
+std::vector<std::string> split(const std::string& list) {
+  std::vector<std::string> out;
+  std::stringstream s(list);
+  for (std::string item; std::getline(s, item, ',');)
+    if (!item.empty()) out.push_back(item);
+  return out;
+}
+
+void check_options(const std::vector<std::string>& args, const std::vector<std::string>& allowed) {
+  for (size_t i = 1; i < args.size(); i += 2) {
+    if (std::find(allowed.begin(), allowed.end(), args[i]) == allowed.end())
+      throw InputError("morphfem robot " + args[0], "unknown option '" + args[i] + "'\n" + kRobotUsage);
+    if (i + 1 >= args.size()) throw InputError("morphfem robot " + args[0], "option " + args[i] + " needs a value");
+  }
+}
 
 const std::vector<RobotFidelity>& robot_fidelity_levels() {
   // Mesh size against the 1 cm skin layers and 4 mm deflated bladders; the time
@@ -327,36 +363,6 @@ std::vector<CaseOutcome> run_jobs(const std::vector<std::pair<RobotCase, RobotFi
     out[j] = {v[0], v[1], v[2], v[3], v[4], v[5], v[6]};
   }
   return out;
-}
-
-std::string option(const std::vector<std::string>& args, const std::string& name, const std::string& fallback) {
-  for (size_t i = 0; i + 1 < args.size(); ++i)
-    if (args[i] == name) return args[i + 1];
-  return fallback;
-}
-
-// Every value of a repeatable option (--set A --set B).
-std::vector<std::string> options(const std::vector<std::string>& args, const std::string& name) {
-  std::vector<std::string> out;
-  for (size_t i = 1; i + 1 < args.size(); i += 2)
-    if (args[i] == name) out.push_back(args[i + 1]);
-  return out;
-}
-
-std::vector<std::string> split(const std::string& list) {
-  std::vector<std::string> out;
-  std::stringstream s(list);
-  for (std::string item; std::getline(s, item, ',');)
-    if (!item.empty()) out.push_back(item);
-  return out;
-}
-
-void check_options(const std::vector<std::string>& args, const std::vector<std::string>& allowed) {
-  for (size_t i = 1; i < args.size(); i += 2) {
-    if (std::find(allowed.begin(), allowed.end(), args[i]) == allowed.end())
-      throw InputError("morphfem robot " + args[0], "unknown option '" + args[i] + "'\n" + kRobotUsage);
-    if (i + 1 >= args.size()) throw InputError("morphfem robot " + args[0], "option " + args[i] + " needs a value");
-  }
 }
 
 const RobotCase& find_case(const std::vector<RobotCase>& cases, const std::string& name) {
@@ -693,6 +699,7 @@ int robot_main(const std::vector<std::string>& args, MPI_Comm comm) {
   if (args[0] == "morph") return morph(args, comm);
   if (args[0] == "friction-sweep") return friction_sweep(args, comm);
   if (args[0] == "benchmark") return benchmark(args, comm);
+  if (args[0] == "friction-drag") return robot_friction_drag(args, comm);
   if (args[0] == "levels") {
     for (const auto& l : robot_fidelity_levels())
       std::printf("level %s: mesh_size %.4g m, P%d, max_step %.4g s\n", l.name.c_str(), l.mesh_size, l.order,

@@ -100,6 +100,18 @@ void register_robot_fitness();
 // length of its middle (reference y), away from the sealed ends that stay flat.
 Eigen::Vector3d cross_section_extents(const Mesh& mesh, const RowMatrixXd& u);
 
+// Command-line helpers of `morphfem robot COMMAND` (args[0] = COMMAND, then option
+// value pairs): the value of an option (or the fallback), every value of a repeatable
+// option, a comma-separated list, and a check that every option is known and has a
+// value (InputError with the usage otherwise).
+std::string option(const std::vector<std::string>& args, const std::string& name, const std::string& fallback);
+std::vector<std::string> options(const std::vector<std::string>& args, const std::string& name);
+std::vector<std::string> split(const std::string& list);
+void check_options(const std::vector<std::string>& args, const std::vector<std::string>& allowed);
+
+// `morphfem robot friction-drag` (app/robot_drag.cpp): the pull test on a robot scene.
+int robot_friction_drag(const std::vector<std::string>& args, MPI_Comm comm);
+
 // `morphfem robot validate|ladder ...` (usage in robot_study.cpp).
 int robot_main(const std::vector<std::string>& args, MPI_Comm comm);
 

@@ -22,6 +22,7 @@ struct SimulationResult {
   std::vector<std::string> cavity_names;
   std::vector<double> cavity_pressure, cavity_volume;  // final [Pa], [m^3]
   double min_J = 0;                                    // smallest det F over quadrature points at the end
+  double mass_kg = 0;                                  // sum of rho V over the cells [kg]
   std::string output_dir;                              // where results went ("" if none)
   // Gait (scenes with an actuation schedule): centroid path (t, x, y, z) every step,
   // displacement along the heading over the gait [m] and speed [body lengths / s].

@@ -292,7 +292,7 @@ Mesh build_robot_voxel(const ParamSet& params) {
 Mesh build_robot_physical(const ParamSet& params) {
   params.allow_only({"type", "mesh_size", "order", "width", "length", "skin_thickness", "fabric_thickness", "core_gap",
                      "edge_width", "end_seal", "bladder_thickness", "bladder_wall", "bladder_width", "foot_length",
-                     "bladder_end_walls"});
+                     "bladder_end_walls", "foot_pad"});
   const CommonRobot c = common_robot(params, 0.10, 0.15, 0.001, 0.005, 0.005, 0.003, 0.02, 0.02);
   // 0: chambers open at both ends (no end walls), e.g. for a plane-strain slice in which
   // the chambers run through the whole slice (foot_length 0) as open sleeves.
@@ -306,19 +306,31 @@ Mesh build_robot_physical(const ParamSet& params) {
   if (end_walls)
     require(2 * w < c.length - 2 * c.foot_length, params, "bladder_wall",
             "the bladder walls must leave a chamber along the axis");
+  // Foot pads: solid blocks (volume region `foot`) under the skin in the two foot bands,
+  // pad thick, standing in for the foot balloons in their laminae; their bottom faces are
+  // the feet. A pad thicker than the lower bladders lifts the body so that the robot
+  // stands on its feet. 0: no pads (the feet are the skin's bottom faces).
+  const double pad = params.number_in("foot_pad", 0.0, kHuge, 0.0);
+  require(pad == 0.0 || c.foot_length > 0, params, "foot_pad", "foot pads need feet: foot_length > 0");
 
   Assembly a;
   a.length = c.length;
   a.foot_length = c.foot_length;
   a.volume_order = volume_order(true);
+  if (pad > 0) a.volume_order.push_back("foot");
   const double hb = c.bladder_thickness, ds = 0.5 * (t - tf);
-  const double z_core = hb + t, z_top = z_core + c.core_gap, z_upper = z_top + t;
-  a.foot_z = hb;
+  const double base = std::max(0.0, pad - hb);  // lift of the body over the ground plane z = 0
+  const double z_skin = base + hb, z_core = z_skin + t, z_top = z_core + c.core_gap, z_upper = z_top + t;
+  a.foot_z = z_skin - pad;
   a.scale = std::max({c.width, c.length, z_upper + hb});
+  if (pad > 0) {
+    a.pieces.push_back({axis_box(0, c.width, 0, c.foot_length, a.foot_z, z_skin), "foot"});
+    a.pieces.push_back({axis_box(0, c.width, c.length - c.foot_length, c.length, a.foot_z, z_skin), "foot"});
+  }
   // Each skin layer: DS10 | fabric | DS10; the lowest sheet is split at the feet.
-  add_split_layer(a, c.width, hb, hb + ds, "skin");
-  a.pieces.push_back({axis_box(0, c.width, 0, c.length, hb + ds, hb + ds + tf), "fabric"});
-  a.pieces.push_back({axis_box(0, c.width, 0, c.length, hb + ds + tf, z_core), "skin"});
+  add_split_layer(a, c.width, z_skin, z_skin + ds, "skin");
+  a.pieces.push_back({axis_box(0, c.width, 0, c.length, z_skin + ds, z_skin + ds + tf), "fabric"});
+  a.pieces.push_back({axis_box(0, c.width, 0, c.length, z_skin + ds + tf, z_core), "skin"});
   add_core(a, c.width, c.edge, c.seal, z_core, z_top);
   a.pieces.push_back({axis_box(0, c.width, 0, c.length, z_top, z_top + ds), "skin"});
   a.pieces.push_back({axis_box(0, c.width, 0, c.length, z_top + ds, z_top + ds + tf), "fabric"});
@@ -328,7 +340,7 @@ Mesh build_robot_physical(const ParamSet& params) {
   const double y0 = c.foot_length, y1 = c.length - c.foot_length, we = end_walls ? w : 0.0;
   for (int k = 1; k <= kBladders; ++k) {
     const auto [x0, x1] = column_x(bladder_column(k), c.width, c.bladder_width);
-    const double z0 = k <= 4 ? z_upper : 0.0, z1 = z0 + hb;
+    const double z0 = k <= 4 ? z_upper : base, z1 = z0 + hb;
     const std::string name = bladder_name(k);
     a.pieces.push_back({axis_box(x0, x1, y0, y1, z0, z0 + w), name});
     a.pieces.push_back({axis_box(x0, x1, y0, y1, z1 - w, z1), name});

@@ -38,9 +38,13 @@
 //   bladder_thickness 0.003, bladder_wall 0.0008 (DS30 wall around each chamber),
 //   bladder_width 0.02, foot_length 0.02 (bladders span y in [foot_length,
 //   length - foot_length]), bladder_end_walls 1 (0: chambers open at both ends, as
-//   sleeves along y, e.g. through a whole plane-strain slice with foot_length 0).
+//   sleeves along y, e.g. through a whole plane-strain slice with foot_length 0),
+//   foot_pad 0 (> 0: a solid pad that thick under the skin in each foot band, volume
+//   `foot`, standing in for the foot balloon in its lamina; its bottom face is the foot.
+//   A pad thicker than bladder_thickness lifts the body: the robot stands on its feet
+//   with the pads' bottoms at z = 0, as in a pull test).
 //   Volumes: skin (DS10: both layers without the fabric, the bonding strips), fabric,
-//   bladder_1 .. bladder_8 (DS30 chamber walls).
+//   bladder_1 .. bladder_8 (DS30 chamber walls), foot (with foot_pad > 0).
 //   Surfaces: core_wall, bladder_1_wall .. bladder_8_wall (closed chamber cavities),
 //   bottom, foot_a, foot_b, outer (as for robot_voxel).
 #pragma once

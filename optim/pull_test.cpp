@@ -287,7 +287,8 @@ PullCurve synthesize_pull(const SyntheticPull& p) {
   return c;
 }
 
-std::string pull_export_text(const PullCurve& c, double weight_N, bool decimal_comma) {
+std::string pull_export_text(const PullCurve& c, double weight_N, bool decimal_comma, const std::string& machine,
+                             double speed_mm_per_min) {
   std::ostringstream o;
   auto num = [&](double v, int digits) {
     std::ostringstream s;
@@ -298,11 +299,11 @@ std::string pull_export_text(const PullCurve& c, double weight_N, bool decimal_c
   };
   o << "Specimen label;" << c.label << ";;\n"
     << "Test type;Pull test (friction);;\n"
-    << "Machine;Instron 3343 (synthetic);;\n"
+    << "Machine;" << machine << ";;\n"
     << "Surface;" << c.surface << ";;\n"
     << "Foot state;" << c.foot_state << ";;\n"
     << "Robot weight (N);" << num(weight_N, 8) << ";;\n"
-    << "Speed (mm/min);" << num(100.0, 6) << ";;\n"
+    << "Speed (mm/min);" << num(speed_mm_per_min, 6) << ";;\n"
     << ";;;\n"
     << "Time;Extension;Load\n"
     << "(s);(mm);(N)\n";

@@ -108,8 +108,9 @@ struct SyntheticPull {
 PullCurve synthesize_pull(const SyntheticPull& p);
 
 // An Instron-like export of a curve (';' separated, decimal commas if asked,
-// header block with surface / foot state / weight, names row, units row).
-std::string pull_export_text(const PullCurve& curve, double weight_N, bool decimal_comma);
+// header block with surface / foot state / weight / machine / speed, names row, units row).
+std::string pull_export_text(const PullCurve& curve, double weight_N, bool decimal_comma,
+                             const std::string& machine = "Instron 3343 (synthetic)", double speed_mm_per_min = 100.0);
 
 // `morphfem calibrate pull-tests --weight-N W FILES_OR_DIRS... [--out DIR]` and
 // `morphfem calibrate synth-pull --out DIR [--surface S --foot F --mu-linear ...]`.

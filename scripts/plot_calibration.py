@@ -4,6 +4,7 @@
 usage: plot_calibration.py pull      pull_tests.csv        out.png   # box plot per surface / foot state
        plot_calibration.py friction  friction_overlay.csv  out.png   # data curves and the fitted simulation
        plot_calibration.py materials material_fit_curves.csv out.png # tensile data and fitted laws
+       plot_calibration.py curves    friction_drag_curves.csv out.png # simulated pull curves (robot friction-drag)
 """
 import csv
 import sys
@@ -58,6 +59,28 @@ def plot_friction(rows, png):
     fig.savefig(png, dpi=120)
 
 
+def plot_curves(rows, png):
+    curves = OrderedDict()
+    for r in rows:
+        curves.setdefault(r["curve"], ([], []))
+        curves[r["curve"]][0].append(float(r["displacement_mm"]))
+        curves[r["curve"]][1].append(float(r["force_N"]))
+    fig, (ax, zoom) = plt.subplots(1, 2, figsize=(11, 4.5))
+    for name, (x, f) in curves.items():
+        for a in (ax, zoom):
+            a.plot(x, f, "-", lw=1.2, label=name)
+    zoom.set_xlim(0, min(10.0, max(max(x) for x, _ in curves.values())))
+    ax.set_title("load against extension")
+    zoom.set_title("pre-slip rise and static peak")
+    for a in (ax, zoom):
+        a.set_xlabel("crosshead travel [mm]")
+        a.set_ylabel("pull force [N]")
+        a.grid(alpha=0.3)
+        a.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(png, dpi=120)
+
+
 def plot_materials(rows, png):
     materials = OrderedDict()
     for r in rows:
@@ -79,11 +102,11 @@ def plot_materials(rows, png):
 
 
 def main():
-    if len(sys.argv) != 4 or sys.argv[1] not in ("pull", "friction", "materials"):
+    if len(sys.argv) != 4 or sys.argv[1] not in ("pull", "friction", "materials", "curves"):
         print(__doc__, file=sys.stderr)
         return 2
     rows = read_rows(sys.argv[2])
-    {"pull": plot_pull, "friction": plot_friction, "materials": plot_materials}[sys.argv[1]](rows, sys.argv[3])
+    {"pull": plot_pull, "friction": plot_friction, "materials": plot_materials, "curves": plot_curves}[sys.argv[1]](rows, sys.argv[3])
     return 0
 
 

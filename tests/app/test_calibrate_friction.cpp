@@ -32,6 +32,7 @@ TEST(CalibrateFriction, RecoversSimulatedCoefficientsWithinTwoPercent) {
   truth.travel = 0.005;
   const DragCurve clean = run_drag_test(truth, PETSC_COMM_WORLD);
   ASSERT_TRUE(clean.completed);
+  EXPECT_NEAR(clean.mass_kg * 9.81, truth.weight_N, 1e-9);  // the block's density is W / (g V)
   std::vector<PullCurve> curves;
   std::mt19937 rng(11);
   std::normal_distribution<double> noise(0.0, 0.003);  // load-cell noise [N]

@@ -324,6 +324,43 @@ TEST(RobotGeometry, PhysicalSliceWithOpenChambers) {
                InputError);
 }
 
+// foot_pad: a DS10 pad under the skin in each foot band (volume `foot`) whose bottom
+// is the foot. A pad 1 mm thicker than the lower bladders lifts the body by 1 mm: the
+// feet are the lowest faces (z = 0), the lower bladders' bottoms 1 mm above the ground.
+TEST(RobotGeometry, PhysicalFootPadsCarryTheBody) {
+  const double W = 0.10, L = 0.15, foot = 0.02, hb = 0.003, pad = 0.004;
+  const Mesh mesh = build_geometry(robot_params("robot_physical", {{"mesh_size", 0.01}, {"foot_pad", pad}}));
+  const auto volumes = mesh.region_names(3);
+  ASSERT_EQ(std::count(volumes.begin(), volumes.end(), "foot"), 1);
+  EXPECT_NEAR(region_volume(mesh, "foot"), 2 * W * foot * pad, 1e-10 * W * foot * pad);
+  expect_downward_in_plane(mesh, "foot_a", 0.0, 0.0, foot);
+  expect_downward_in_plane(mesh, "foot_b", 0.0, L - foot, L);
+  EXPECT_NEAR(area(mesh, "foot_a"), W * foot, 1e-12);
+  EXPECT_NEAR(area(mesh, "foot_b"), W * foot, 1e-12);
+  EXPECT_NEAR(area(mesh, "bottom"), W * L, 1e-12);
+  for (int k = 5; k <= 8; ++k) {
+    double z_min = 1.0;
+    for (int c : mesh.cells_of("bladder_" + std::to_string(k)))
+      for (int i = 0; i < 4; ++i) z_min = std::min(z_min, node(mesh, mesh.cells(c, i)).z());
+    EXPECT_NEAR(z_min, pad - hb, 1e-12) << k;
+  }
+  double lowest = 1.0;
+  for (int n = 0; n < mesh.X.rows(); ++n) lowest = std::min(lowest, mesh.X(n, 2));
+  EXPECT_NEAR(lowest, 0.0, 1e-12);
+  // The boundary still closes around every solid, the pads included.
+  std::vector<std::string> boundary = bladder_names("_wall");
+  for (const char* name : {"core_wall", "bottom", "outer"}) boundary.push_back(name);
+  double solid = 0.0;
+  for (const std::string& v : volumes) solid += region_volume(mesh, v);
+  const auto [all, residual] = enclosed_volume(mesh, boundary);
+  EXPECT_NEAR(all, -solid, 1e-10 * solid);
+  EXPECT_LT(residual, 1e-14);
+  EXPECT_THROW(
+      build_geometry(robot_params("robot_physical",
+                                  {{"mesh_size", 0.01}, {"foot_pad", 0.004}, {"foot_length", 0.0}, {"length", 0.01}})),
+      InputError);
+}
+
 TEST(RobotGeometry, PhysicalPresetP2) {
   const Mesh mesh = build_geometry(robot_params("robot_physical", {{"mesh_size", 0.03}, {"order", 2}}));
   EXPECT_EQ(mesh.order, 2);
