@@ -108,28 +108,33 @@ double CavityPressureTerm::piece(int k, const PieceState& s, Eigen::VectorXd* g,
   return scale * f;
 }
 
-double CavityPressureTerm::volume(Assembler& assembler, Vec u) const {
-  const auto& ghost = assembler.gather(u);
-  const double n_axes = spec_.axes[0] + spec_.axes[1] + spec_.axes[2];
+double cavity_wall_volume(const EnergyTerm& wall, const Mesh& mesh, const Assembler& assembler,
+                          const std::vector<double>& u_ghost, const ShapeTable& table, const std::array<bool, 3>& axes,
+                          int open_axis) {
+  const double n_axes = axes[0] + axes[1] + axes[2];
   std::vector<int> nodes;
   Eigen::MatrixXd X, x;
   double local = 0.0;
-  for (int k = 0; k < n_pieces(); ++k) {
-    piece_nodes(k, nodes);
-    X.resize(nodes.size(), 3);
-    x.resize(nodes.size(), 3);
+  for (int k = 0; k < wall.n_pieces(); ++k) {
+    wall.piece_nodes(k, nodes);
+    X.resize(static_cast<Eigen::Index>(nodes.size()), 3);
+    x.resize(static_cast<Eigen::Index>(nodes.size()), 3);
     for (size_t a = 0; a < nodes.size(); ++a) {
       const int slot = assembler.node_slot(nodes[a]);
       for (int i = 0; i < 3; ++i) {
-        X(a, i) = mesh_.X(nodes[a], i);
-        x(a, i) = X(a, i) + ghost[3 * slot + i];
+        X(a, i) = mesh.X(nodes[a], i);
+        x(a, i) = X(a, i) + u_ghost[3 * slot + i];
       }
     }
-    local -= cavity_wall_integral(table_, spec_.axes, spec_.open_axis, X, x, nullptr, nullptr) / n_axes;
+    local -= cavity_wall_integral(table, axes, open_axis, X, x, nullptr, nullptr) / n_axes;
   }
   double total = 0.0;
   MPI_Allreduce(&local, &total, 1, MPI_DOUBLE, MPI_SUM, assembler.comm());
   return total;
+}
+
+double CavityPressureTerm::volume(Assembler& assembler, Vec u) const {
+  return cavity_wall_volume(*this, mesh_, assembler, assembler.gather(u), table_, spec_.axes, spec_.open_axis);
 }
 
 }  // namespace morphfem

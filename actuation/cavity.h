@@ -52,6 +52,13 @@ double cavity_face_integral(const ShapeTable& table, const std::array<bool, 3>& 
 double cavity_wall_integral(const ShapeTable& table, const std::array<bool, 3>& axes, int open_axis,
                             const Eigen::MatrixXd& X, const Eigen::MatrixXd& x, Eigen::VectorXd* g, Eigen::MatrixXd* H);
 
+// Volume enclosed by a cavity wall [m^3]: -(1/|S|) sum over the wall term's pieces (its
+// faces on this rank) of the wall integral at x = X + u, summed over the ranks
+// (collective). u_ghost: the rank's ghosted displacement (Assembler::gather).
+double cavity_wall_volume(const EnergyTerm& wall, const Mesh& mesh, const Assembler& assembler,
+                          const std::vector<double>& u_ghost, const ShapeTable& table, const std::array<bool, 3>& axes,
+                          int open_axis);
+
 class CavityPressureTerm : public EnergyTerm {
  public:
   CavityPressureTerm(const Mesh& mesh, const Partition& partition, int rank, CavitySpec spec);

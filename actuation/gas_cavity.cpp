@@ -95,21 +95,7 @@ double CavityVolumeTerm::face_volume(int k, const Eigen::MatrixXd& x, Eigen::Vec
 
 // Volume of the meshed part [m^3] from this rank's ghosted displacement (collective).
 double CavityVolumeTerm::meshed_volume(const Assembler& assembler, const std::vector<double>& u_local) const {
-  std::vector<int> nodes;
-  Eigen::MatrixXd x;
-  double local = 0.0;
-  for (int k = 0; k < n_pieces(); ++k) {
-    piece_nodes(k, nodes);
-    x.resize(static_cast<Eigen::Index>(nodes.size()), 3);
-    for (size_t a = 0; a < nodes.size(); ++a) {
-      const int slot = assembler.node_slot(nodes[a]);
-      for (int i = 0; i < 3; ++i) x(a, i) = mesh_.X(nodes[a], i) + u_local[3 * slot + i];
-    }
-    local += face_volume(k, x, nullptr, nullptr);
-  }
-  double total = 0.0;
-  MPI_Allreduce(&local, &total, 1, MPI_DOUBLE, MPI_SUM, assembler.comm());
-  return total;
+  return cavity_wall_volume(*this, mesh_, assembler, u_local, table_, wall_.axes, wall_.open_axis);
 }
 
 void CavityVolumeTerm::prepare(const Assembler& assembler, const std::vector<double>& u_local) {

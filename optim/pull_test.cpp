@@ -196,7 +196,11 @@ PullAnalysis analyse_pull(const PullCurve& curve, double weight_N) {
       }
     }
   }
-  if (knee && sse_line - best_sse < 25.0 * a.noise_N * a.noise_N) {
+  // A knee must improve the fit by more than the noise, and by more than a load cell
+  // resolves (0.1 % of the peak force): a noise-free (simulated) curve would otherwise
+  // take the slight, gradual creep of its regularised friction for a knee.
+  const double resolution = std::max(a.noise_N, 1e-3 * a.peak_force_N);
+  if (knee && sse_line - best_sse < 25.0 * resolution * resolution) {
     knee = false;
     best_b = 1.0;
     best_a = line(0);

@@ -27,7 +27,9 @@
 //      the curve starts to bend away from the line, not where it has bent by some
 //      threshold (a threshold biases x_L to the right by the knee's curvature).
 //      If the bend is not significant (the hinge lowers the sum of squares by less
-//      than 25 sigma^2: many (b, l) are tried, so noise alone lowers it by ~10 sigma^2)
+//      than 25 s^2, s = max(sigma, 0.1 % of the peak force): many (b, l) are tried, so
+//      noise alone lowers it by ~10 sigma^2; the floor is what a load cell resolves, and
+//      keeps a noise-free simulated curve's gradual creep from passing for a knee)
 //      the whole window is linear: b = x_p.
 //   x_L = b and F(x_L) = a + k b, the fitted line there (denoised), so mu_linear
 //   does not carry the noise of one sample.
