@@ -37,13 +37,30 @@ def plot_pull(rows, png):
     fig.savefig(png, dpi=120)
 
 
-def plot_friction(rows, png):
+def read_curves(rows):
+    """Rows (curve, displacement_mm, force_N) -> {curve: (x [mm], F [N])} in file order."""
     curves = OrderedDict()
     for r in rows:
         curves.setdefault(r["curve"], ([], []))
         curves[r["curve"]][0].append(float(r["displacement_mm"]))
         curves[r["curve"]][1].append(float(r["force_N"]))
-    fig, ax = plt.subplots(figsize=(7, 4.5))
+    return curves
+
+
+def finish_pull_axes(axes, png, legend_size):
+    """Labels, grid and legend of force-travel axes; saves the figure."""
+    for a in axes:
+        a.set_xlabel("crosshead travel [mm]")
+        a.set_ylabel("pull force [N]")
+        a.grid(alpha=0.3)
+        a.legend(fontsize=legend_size)
+    axes[0].figure.tight_layout()
+    axes[0].figure.savefig(png, dpi=120)
+
+
+def plot_friction(rows, png):
+    curves = read_curves(rows)
+    _, ax = plt.subplots(figsize=(7, 4.5))
     for name, (x, f) in curves.items():
         if name == "simulated":
             continue
@@ -51,34 +68,19 @@ def plot_friction(rows, png):
     if "simulated" in curves:
         x, f = curves["simulated"]
         ax.plot(x, f, "k-", lw=1.5, label="simulated (fitted)")
-    ax.set_xlabel("crosshead travel [mm]")
-    ax.set_ylabel("pull force [N]")
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize=7)
-    fig.tight_layout()
-    fig.savefig(png, dpi=120)
+    finish_pull_axes([ax], png, 7)
 
 
 def plot_curves(rows, png):
-    curves = OrderedDict()
-    for r in rows:
-        curves.setdefault(r["curve"], ([], []))
-        curves[r["curve"]][0].append(float(r["displacement_mm"]))
-        curves[r["curve"]][1].append(float(r["force_N"]))
-    fig, (ax, zoom) = plt.subplots(1, 2, figsize=(11, 4.5))
+    curves = read_curves(rows)
+    _, (ax, zoom) = plt.subplots(1, 2, figsize=(11, 4.5))
     for name, (x, f) in curves.items():
         for a in (ax, zoom):
             a.plot(x, f, "-", lw=1.2, label=name)
     zoom.set_xlim(0, min(10.0, max(max(x) for x, _ in curves.values())))
     ax.set_title("load against extension")
     zoom.set_title("pre-slip rise and static peak")
-    for a in (ax, zoom):
-        a.set_xlabel("crosshead travel [mm]")
-        a.set_ylabel("pull force [N]")
-        a.grid(alpha=0.3)
-        a.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(png, dpi=120)
+    finish_pull_axes([ax, zoom], png, 8)
 
 
 def plot_materials(rows, png):
