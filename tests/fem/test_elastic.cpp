@@ -9,6 +9,7 @@
 #include "fem/loads.h"
 #include "fem/material.h"
 #include "tests/support/finite_differences.h"
+#include "tests/support/one_tet.h"
 
 using namespace morphfem;
 
@@ -22,30 +23,6 @@ double monomial_integral(int a, int b, int c) {
     return f;
   };
   return fact(a) * fact(b) * fact(c) / fact(a + b + c + 3);
-}
-
-Mesh single_tet(int order, unsigned seed) {
-  Mesh m;
-  m.order = order;
-  const int n = order == 1 ? 4 : 10;
-  m.X.resize(n, 3);
-  m.X.row(0) << 0, 0, 0;
-  m.X.row(1) << 1, 0.1, 0;
-  m.X.row(2) << 0.2, 0.9, 0.1;
-  m.X.row(3) << 0.1, 0.2, 1.1;
-  if (order == 2) {
-    const int edge[6][2] = {{0, 1}, {1, 2}, {0, 2}, {0, 3}, {1, 3}, {2, 3}};
-    std::mt19937 rng(seed);
-    std::uniform_real_distribution<double> d(-0.03, 0.03);
-    for (int e = 0; e < 6; ++e)
-      for (int i = 0; i < 3; ++i) m.X(4 + e, i) = 0.5 * (m.X(edge[e][0], i) + m.X(edge[e][1], i)) + d(rng);
-  }
-  m.X *= 0.01;  // 1 cm
-  m.cells.resize(1, n);
-  for (int a = 0; a < n; ++a) m.cells(0, a) = a;
-  m.cell_region = {0};
-  m.regions = {Region{"body", 3, 0}};
-  return m;
 }
 
 }  // namespace
@@ -107,7 +84,7 @@ TEST_P(ElasticFD, GradientAndHessianMatchFiniteDifferences) {
   }
   p.set("kappa", 2e6);
   std::shared_ptr<const Material> law = make_material(p);
-  Mesh mesh = single_tet(order, 7);
+  Mesh mesh = morphfem::testing::one_tet(order, 7);
   Partition part{1, {0}, {0, mesh.n_nodes()}};
   ElasticTerm term(mesh, part, 0, {law}, order == 1 ? 1 : 4);
   std::mt19937 rng(3);
@@ -134,7 +111,7 @@ TEST(ElasticTerm, InvertedElementHasInfiniteEnergy) {
   p.set_string("model", "neo_hookean");
   p.set("mu", 1e5);
   p.set("kappa", 1e6);
-  Mesh mesh = single_tet(1, 1);
+  Mesh mesh = morphfem::testing::one_tet(1, 1);
   Partition part{1, {0}, {0, 4}};
   ElasticTerm term(mesh, part, 0, {make_material(p)});
   PieceState s{mesh.X, Eigen::MatrixXd::Zero(4, 3)};
@@ -145,7 +122,7 @@ TEST(ElasticTerm, InvertedElementHasInfiniteEnergy) {
 
 TEST(BodyForce, GravityWorkEqualsWeightTimesCentroidDrop) {
   for (int order : {1, 2}) {
-    Mesh mesh = single_tet(order, 2);
+    Mesh mesh = morphfem::testing::one_tet(order, 2);
     Partition part{1, {0}, {0, mesh.n_nodes()}};
     const Eigen::Vector3d b(0, 0, -1000 * 9.81);
     BodyForceTerm term(
@@ -180,7 +157,7 @@ std::shared_ptr<const Material> yeoh_for_growth() {
 
 TEST(Growth, GradientAndHessianMatchFiniteDifferences) {
   for (int order : {1, 2}) {
-    Mesh mesh = single_tet(order, 5);
+    Mesh mesh = morphfem::testing::one_tet(order, 5);
     Partition part{1, {0}, {0, mesh.n_nodes()}};
     ElasticTerm term(mesh, part, 0, {yeoh_for_growth()}, order == 1 ? 1 : 4);
     term.set_growth(0, [](double t) { return Eigen::Vector3d(1.0 + 0.1 * t, 1.0 + 0.6 * t, 1.0 + 4.0 * t); });
@@ -200,7 +177,7 @@ TEST(Growth, GradientAndHessianMatchFiniteDifferences) {
 TEST(Growth, GrownShapeIsStressFreeAndOthersAreNot) {
   // u = (G - I) X makes F = G: zero energy and zero force; the undeformed state
   // then carries the growth's strain energy.
-  Mesh mesh = single_tet(2, 3);
+  Mesh mesh = morphfem::testing::one_tet(2, 3);
   Partition part{1, {0}, {0, mesh.n_nodes()}};
   ElasticTerm term(mesh, part, 0, {yeoh_for_growth()}, 4);
   const Eigen::Vector3d stretch(1.115, 2.35, 12.5);  // the voxel study's inflated bladder at p = 0

@@ -10,35 +10,11 @@
 #include "fem/kinematics.h"
 #include "fem/mean_dilatation.h"
 #include "tests/support/finite_differences.h"
+#include "tests/support/one_tet.h"
 
 using namespace morphfem;
 
 namespace {
-
-// One tetrahedron (1 cm), P2 mid-nodes moved off the edge midpoints (curved cell).
-Mesh one_tet(int order, unsigned seed) {
-  Mesh m;
-  m.order = order;
-  const int n = order == 1 ? 4 : 10;
-  m.X.resize(n, 3);
-  m.X.row(0) << 0, 0, 0;
-  m.X.row(1) << 1, 0.1, 0;
-  m.X.row(2) << 0.2, 0.9, 0.1;
-  m.X.row(3) << 0.1, 0.2, 1.1;
-  if (order == 2) {
-    const int edge[6][2] = {{0, 1}, {1, 2}, {0, 2}, {0, 3}, {1, 3}, {2, 3}};
-    std::mt19937 rng(seed);
-    std::uniform_real_distribution<double> d(-0.03, 0.03);
-    for (int e = 0; e < 6; ++e)
-      for (int i = 0; i < 3; ++i) m.X(4 + e, i) = 0.5 * (m.X(edge[e][0], i) + m.X(edge[e][1], i)) + d(rng);
-  }
-  m.X *= 0.01;
-  m.cells.resize(1, n);
-  for (int a = 0; a < n; ++a) m.cells(0, a) = a;
-  m.cell_region = {0};
-  m.regions = {Region{"body", 3, 0}};
-  return m;
-}
 
 // Laws with a large bulk modulus (kappa / mu ~ 1000, nu ~ 0.4995).
 std::shared_ptr<const Material> law(const std::string& name) {
@@ -131,7 +107,7 @@ TEST(MaterialSplit, IsochoricStressAndTangentMatchFiniteDifferences) {
 class MeanDilatationFD : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(MeanDilatationFD, GradientAndHessianMatchFiniteDifferences) {
-  Mesh mesh = one_tet(2, 7);
+  Mesh mesh = morphfem::testing::one_tet(2, 7);
   Partition part{1, {0}, {0, mesh.n_nodes()}};
   MeanDilatationTerm term(mesh, part, 0, {law(GetParam())});
   for (unsigned seed : {3u, 4u}) {
@@ -157,7 +133,7 @@ INSTANTIATE_TEST_SUITE_P(Laws, MeanDilatationFD, ::testing::ValuesIn(kLaws));
 
 TEST(MeanDilatation, EqualsTheDisplacementElementForAffineMotion) {
   // Uniform F: Theta = J, so V U(Theta) = int U(J) dV and both elements agree.
-  Mesh mesh = one_tet(2, 9);
+  Mesh mesh = morphfem::testing::one_tet(2, 9);
   for (int a = 4; a < 10; ++a) {  // straight edges: an affine field is exactly representable
     const int edge[6][2] = {{0, 1}, {1, 2}, {0, 2}, {0, 3}, {1, 3}, {2, 3}};
     mesh.X.row(a) = 0.5 * (mesh.X.row(edge[a - 4][0]) + mesh.X.row(edge[a - 4][1]));
@@ -179,7 +155,7 @@ TEST(MeanDilatation, EqualsTheDisplacementElementForAffineMotion) {
 }
 
 TEST(MeanDilatation, RigidRotationHasZeroEnergyAndInversionIsInfinite) {
-  Mesh mesh = one_tet(2, 3);
+  Mesh mesh = morphfem::testing::one_tet(2, 3);
   Partition part{1, {0}, {0, mesh.n_nodes()}};
   MeanDilatationTerm term(mesh, part, 0, {law("neo_hookean")});
   const Mat3 R = Eigen::AngleAxisd(1.1, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
@@ -191,11 +167,11 @@ TEST(MeanDilatation, RigidRotationHasZeroEnergyAndInversionIsInfinite) {
 }
 
 TEST(MeanDilatation, RejectsLinearTetrahedra) {
-  Mesh mesh = one_tet(1, 1);
+  Mesh mesh = morphfem::testing::one_tet(1, 1);
   Partition part{1, {0}, {0, 4}};
   EXPECT_THROW(MeanDilatationTerm(mesh, part, 0, {law("neo_hookean")}), InputError);
   ASSERT_TRUE(elastic_formulations().count("mean_dilatation"));
-  Mesh p2 = one_tet(2, 1);
+  Mesh p2 = morphfem::testing::one_tet(2, 1);
   Partition part2{1, {0}, {0, 10}};
   auto term = elastic_formulations().at("mean_dilatation")(p2, part2, 0, {law("neo_hookean")}, 0);
   EXPECT_NE(dynamic_cast<MeanDilatationTerm*>(term.get()), nullptr);
