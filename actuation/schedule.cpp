@@ -255,13 +255,7 @@ std::string Schedule::to_yaml() const {
 
 Schedule parse_schedule(const std::string& text, const std::string& source) {
   Reader r{source};
-  YAML::Node root;
-  try {
-    root = YAML::Load(text);
-  } catch (const YAML::ParserException& e) {
-    throw InputError(source + ":" + std::to_string(e.mark.line + 1) + ":" + std::to_string(e.mark.column + 1),
-                     "YAML syntax error: " + e.msg);
-  }
+  const YAML::Node root = load_yaml_text(text, source);
   if (!root.IsMap()) throw InputError(source, "a schedule file is a YAML mapping (key: value)");
   r.allow_only(root, "",
                {"morphfem_schedule", "name", "orientation_deg", "core_pressure_pa", "column_s", "repeats", "settle_s",

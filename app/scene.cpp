@@ -10,6 +10,7 @@
 #include "actuation/schedule_loads.h"
 #include "actuation/voxel_growth.h"
 #include "core/errors.h"
+#include "core/yaml_reader.h"
 #include "fem/elastic.h"
 #include "optim/calibration_file.h"
 
@@ -168,12 +169,7 @@ struct Reader {
 
 YAML::Node load_scene_yaml(const std::string& path) {
   if (!std::filesystem::exists(path)) throw InputError(path, "scene file not found");
-  try {
-    return YAML::LoadFile(path);
-  } catch (const YAML::ParserException& e) {
-    throw InputError(path + ":" + std::to_string(e.mark.line + 1) + ":" + std::to_string(e.mark.column + 1),
-                     "YAML syntax error: " + e.msg);
-  }
+  return load_yaml_file(path, "scene file");
 }
 
 Scene read_scene(const std::string& path) { return scene_from_yaml(load_scene_yaml(path), path); }

@@ -121,17 +121,7 @@ double stiff_bulk_ratio() { return elastic_formulations().count("mean_dilatation
 
 VerificationRecord make_record(const std::string& case_name, const std::string& quantity, int level, int order,
                                double h, long dofs, const RunStats& stats, double value, double reference) {
-  VerificationRecord rec;
-  rec.case_name = case_name;
-  rec.quantity = quantity;
-  rec.level = level;
-  rec.order = order;
-  rec.h = h;
-  rec.dofs = dofs;
-  rec.wall_s = stats.wall_s;
-  rec.newton_its = stats.newton_its;
-  rec.steps = stats.steps;
-  rec.step_cuts = stats.step_cuts;
+  VerificationRecord rec = verification_record(case_name, quantity, level, order, h, dofs, stats);
   rec.value = value;
   rec.reference = reference;
   rec.rel_error = reference != 0 ? std::abs(value - reference) / std::abs(reference) : std::abs(value);

@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <fstream>
 #include <set>
 #include <sstream>
 #include <string>
@@ -19,6 +20,26 @@ inline std::string format_number(double v) {
   std::ostringstream s;
   s << v;
   return s.str();
+}
+
+// Parses YAML text; a syntax error becomes InputError "source:line:col: YAML syntax
+// error: ..." (source names the file in the message).
+inline YAML::Node load_yaml_text(const std::string& text, const std::string& source) {
+  try {
+    return YAML::Load(text);
+  } catch (const YAML::ParserException& e) {
+    throw InputError(source + ":" + std::to_string(e.mark.line + 1) + ":" + std::to_string(e.mark.column + 1),
+                     "YAML syntax error: " + e.msg);
+  }
+}
+
+// Reads and parses a YAML file; InputError "path: cannot open the WHAT" or a syntax error.
+inline YAML::Node load_yaml_file(const std::string& path, const std::string& what) {
+  std::ifstream in(path);
+  if (!in) throw InputError(path, "cannot open the " + what);
+  std::stringstream text;
+  text << in.rdbuf();
+  return load_yaml_text(text.str(), path);
 }
 
 struct YamlReader {

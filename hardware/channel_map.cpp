@@ -80,13 +80,7 @@ void ChannelMap::check_schedule(const Schedule& s) const {
 
 ChannelMap parse_channel_map(const std::string& text, const std::string& source) {
   MapReader r{source};
-  YAML::Node root;
-  try {
-    root = YAML::Load(text);
-  } catch (const YAML::ParserException& e) {
-    throw InputError(source + ":" + std::to_string(e.mark.line + 1) + ":" + std::to_string(e.mark.column + 1),
-                     "YAML syntax error: " + e.msg);
-  }
+  const YAML::Node root = load_yaml_text(text, source);
   if (!root.IsMap()) throw InputError(source, "a channel map is a YAML mapping");
   r.allow_only(root, "", {"morphfem_channel_map", "devices", "channels"});
   if (!root["morphfem_channel_map"])

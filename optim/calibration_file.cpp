@@ -12,6 +12,7 @@
 
 #include "core/errors.h"
 #include "core/json.h"
+#include "core/yaml_reader.h"
 
 namespace morphfem {
 
@@ -127,14 +128,7 @@ void write_calibration_file(const std::string& path, const Calibration& c) {
 }
 
 Calibration read_calibration_file(const std::string& path) {
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(path);
-  } catch (const YAML::BadFile&) {
-    throw InputError(path, "cannot open the calibration file");
-  } catch (const YAML::ParserException& e) {
-    throw InputError(path + ":" + std::to_string(e.mark.line + 1), "YAML syntax error: " + e.msg);
-  }
+  const YAML::Node root = load_yaml_file(path, "calibration file");
   auto at = [&](const YAML::Node& n) { return path + ":" + std::to_string(n.Mark().line + 1); };
   if (!root.IsMap()) throw InputError(path, "a calibration file is a map of keys");
   const std::set<std::string> allowed = {"kind", "command", "created", "group", "parameters", "fit", "data"};
