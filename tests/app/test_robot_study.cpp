@@ -81,7 +81,8 @@ TEST(RobotStudy, PhysicalCasesPlayTheBaselineScheduleOnTheRollingSlice) {
   EXPECT_NEAR(scene.gait.end - scene.gait.start, 16 * hill.schedule.column_s, 1e-8);
   EXPECT_LE(scene.gait.end, scene.solver.t_end);
   EXPECT_NEAR(scene.gravity.x(), -9.80665 * std::sin(15 * M_PI / 180), 1e-9);  // uphill along +x
-  // Chamber 8 is on in column 1 at the template's 25 kPa; the core at the 50 kPa line pressure.
+  // Chamber 8 is on in column 1 at the template's 35 kPa (after its 0.8 s ramp), off in
+  // column 2; the core at the 50 kPa line pressure.
   const CavitySpec* b8 = nullptr;
   const CavitySpec* core = nullptr;
   for (const auto& cav : scene.cavities) {
@@ -89,8 +90,8 @@ TEST(RobotStudy, PhysicalCasesPlayTheBaselineScheduleOnTheRollingSlice) {
     if (cav.name == "core") core = &cav;
   }
   ASSERT_TRUE(b8 && core);
-  const double t1 = scene.gait.start + 0.5 * hill.schedule.column_s, t2 = t1 + hill.schedule.column_s;
-  EXPECT_NEAR(b8->pressure(t1), 25000, 1e-6);
+  const double t1 = scene.gait.start + 0.9 * hill.schedule.column_s, t2 = t1 + hill.schedule.column_s;
+  EXPECT_NEAR(b8->pressure(t1), 35000, 1e-6);
   EXPECT_NEAR(b8->pressure(t2), 0, 1e-6);
   EXPECT_NEAR(core->pressure(t1), 50000, 1e-6);
   EXPECT_EQ(b8->open_axis, 1);
