@@ -158,14 +158,7 @@ SimulationResult run_scene(const Scene& scene, MPI_Comm comm, const RunOptions& 
     if (scene.gravity.norm() > 0 && density[id] <= 0)
       throw InputError(params.where("model"), "gravity is on but material '" + region + "' has no 'density' [kg/m^3]");
   }
-  // Mass sum rho V over the cells [kg] (vertex tetrahedra: exact for straight-sided cells).
-  for (int c = 0; c < mesh.n_cells(); ++c) {
-    const Eigen::Vector3d x0 = mesh.X.row(mesh.cells(c, 0)).transpose();
-    const Eigen::Vector3d e1 = mesh.X.row(mesh.cells(c, 1)).transpose() - x0,
-                          e2 = mesh.X.row(mesh.cells(c, 2)).transpose() - x0,
-                          e3 = mesh.X.row(mesh.cells(c, 3)).transpose() - x0;
-    result.mass_kg += density[mesh.cell_region[c]] * std::abs(e1.dot(e2.cross(e3))) / 6.0;
-  }
+  for (int c = 0; c < mesh.n_cells(); ++c) result.mass_kg += density[mesh.cell_region[c]] * mesh.cell_volume(c);
   Partition partition = partition_mesh(mesh, size);
 
   Assembler assembler(mesh, partition, comm);

@@ -118,9 +118,11 @@ std::vector<int> Mesh::cells_of(const std::string& volume) const {
   return out;
 }
 
+double Mesh::cell_volume(int cell) const { return morphfem::cell_volume(*this, cell); }
+
 double Mesh::volume() const {
   double total = 0.0;
-  for (int c = 0; c < n_cells(); ++c) total += cell_volume(*this, c);
+  for (int c = 0; c < n_cells(); ++c) total += cell_volume(c);
   return total;
 }
 

@@ -50,6 +50,8 @@ struct Mesh {
 
   // Total reference volume [m^3] (exact for straight-sided cells, quadrature for P2).
   double volume() const;
+  // Reference volume of one cell [m^3] (P2: of the curved cell).
+  double cell_volume(int cell) const;
   // Smallest and largest edge length over vertex-to-vertex edges [m].
   std::pair<double, double> edge_length_range() const;
 };
