@@ -24,6 +24,7 @@
 
 #include "app/drag_scene.h"
 #include "app/plot.h"
+#include "app/rank_jobs.h"
 #include "app/robot_study.h"
 #include "app/scene.h"
 #include "core/errors.h"
@@ -124,8 +125,7 @@ int robot_friction_drag(const std::vector<std::string>& args, MPI_Comm comm) {
   MPI_Barrier(comm);
 
   // One foot state per rank (round robin), each on its own rank.
-  std::vector<double> mine(static_cast<size_t>(n) * DragOutcome::kFields, 0.0), all(mine.size(), 0.0);
-  for (int j = rank; j < n; j += size) {
+  const std::vector<double> all = run_jobs_over_ranks(n, DragOutcome::kFields, comm, [&](int j, double* row) {
     const FootState& state = states[j];
     const YAML::Node case_doc = drag_case_yaml(doc, path, parsed, state, travel, out_dir + "/" + state.name);
     const Scene scene = scene_from_yaml(case_doc, path);
@@ -152,7 +152,7 @@ int robot_friction_drag(const std::vector<std::string>& args, MPI_Comm comm) {
                                                  weight,
                                                  slip,
                                                  mu_scene};
-    std::copy(values, values + DragOutcome::kFields, mine.begin() + static_cast<long>(j) * DragOutcome::kFields);
+    std::copy(values, values + DragOutcome::kFields, row);
     if (curve.completed) {  // a failed run leaves no export that reads like a finished test
       PullCurve c;
       c.label = "friction_drag_" + state.name;
@@ -164,8 +164,7 @@ int robot_friction_drag(const std::vector<std::string>& args, MPI_Comm comm) {
       write_file_atomic(export_path(state),
                         pull_export_text(c, weight, false, "morphfem (simulated, " + path + ")", speed * 6e4));
     }
-  }
-  MPI_Allreduce(mine.data(), all.data(), static_cast<int>(all.size()), MPI_DOUBLE, MPI_SUM, comm);
+  });
   if (rank != 0) return 0;
 
   // Read the exports back and analyse them as the measured curves are analysed.

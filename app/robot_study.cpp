@@ -14,6 +14,7 @@
 
 #include "actuation/voxel_growth.h"
 #include "app/plot.h"
+#include "app/rank_jobs.h"
 #include "app/scene.h"
 #include "core/errors.h"
 #include "core/json.h"
@@ -336,10 +337,9 @@ std::vector<CaseOutcome> run_jobs(const std::vector<std::pair<RobotCase, RobotFi
   MPI_Comm_rank(comm, &rank);
   MPI_Comm_size(comm, &size);
   const int n = static_cast<int>(jobs.size());
-  std::vector<double> mine(static_cast<size_t>(n) * CaseOutcome::kFields, 0.0), all(mine.size(), 0.0);
   Progress progress("robot", n, rank == 0);
   int done_here = 0;
-  for (int j = rank; j < n; j += size) {
+  const std::vector<double> all = run_jobs_over_ranks(n, CaseOutcome::kFields, comm, [&](int j, double* row) {
     const auto& [c, level] = jobs[j];
     const std::string dir =
         out_dir.empty() ? "" : out_dir + "/" + c.name + (c.physical ? "_physical" : "_L" + level.name);
@@ -351,12 +351,11 @@ std::vector<CaseOutcome> run_jobs(const std::vector<std::pair<RobotCase, RobotFi
                                                  static_cast<double>(r.stats.steps),
                                                  static_cast<double>(r.stats.newton_its),
                                                  r.stats.completed && r.gait_complete ? 1.0 : 0.0};
-    std::copy(values, values + CaseOutcome::kFields, mine.begin() + static_cast<long>(j) * CaseOutcome::kFields);
+    std::copy(values, values + CaseOutcome::kFields, row);
     ++done_here;
     progress.update(std::min<double>(n, done_here * size), c.name + " L" + level.name);
-  }
+  });
   progress.finish();
-  MPI_Allreduce(mine.data(), all.data(), static_cast<int>(all.size()), MPI_DOUBLE, MPI_SUM, comm);
   std::vector<CaseOutcome> out(n);
   for (int j = 0; j < n; ++j) {
     const double* v = all.data() + static_cast<long>(j) * CaseOutcome::kFields;

@@ -94,6 +94,7 @@ const std::map<std::string, MaterialFactory>& material_registry() {
       {"mooney_rivlin", make_mooney_rivlin},
       {"yeoh", make_yeoh},
       {"ogden", make_ogden},
+      {"fabric", make_fabric},
       {"dragon_skin_10", [](const ParamSet& p) { return make_silicone_preset(p, kDragonSkin10); }},
       {"dragon_skin_30", [](const ParamSet& p) { return make_silicone_preset(p, kDragonSkin30); }},
   };

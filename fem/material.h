@@ -49,7 +49,8 @@ class Material {
 using MaterialFactory = std::function<std::unique_ptr<Material>(const ParamSet&)>;
 
 // name -> factory. Names: neo_hookean (mu, kappa), mooney_rivlin (c10, c01, kappa),
-// yeoh (c1, c2, c3, kappa), ogden (mu: [..], alpha: [..], kappa). Presets
+// yeoh (c1, c2, c3, kappa), ogden (mu: [..], alpha: [..], kappa), fabric (a
+// neo-Hookean matrix mu, kappa plus tension-only fibres: fibre_modulus, fibres). Presets
 // dragon_skin_10 and dragon_skin_30 take optional kappa. The bulk modulus may be
 // given as kappa [Pa] or as Poisson's ratio nu (one of them is required, except for
 // the presets, which default to nu = 0.49). Presets also take `law: yeoh`
@@ -66,6 +67,7 @@ std::unique_ptr<Material> make_neo_hookean(const ParamSet& params);
 std::unique_ptr<Material> make_mooney_rivlin(const ParamSet& params);
 std::unique_ptr<Material> make_yeoh(const ParamSet& params);
 std::unique_ptr<Material> make_ogden(const ParamSet& params);
+std::unique_ptr<Material> make_fabric(const ParamSet& params);
 
 // Helpers for the factories.
 // Bulk modulus [Pa] from `kappa` [Pa] or Poisson's ratio `nu` (exactly one is

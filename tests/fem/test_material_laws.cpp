@@ -287,7 +287,8 @@ TEST(MaterialLaw, ModuliReported) {
 }
 
 TEST(MaterialLaw, RegistryNames) {
-  for (const char* name : {"neo_hookean", "mooney_rivlin", "yeoh", "ogden", "dragon_skin_10", "dragon_skin_30"})
+  for (const char* name :
+       {"neo_hookean", "mooney_rivlin", "yeoh", "ogden", "fabric", "dragon_skin_10", "dragon_skin_30"})
     EXPECT_EQ(material_registry().count(name), 1u) << name;
 }
 
@@ -319,6 +320,73 @@ TEST(MaterialLaw, RejectsBadParameters) {
                      "mu_p alpha_p > 0");
   expect_input_error(make_params("dragon_skin_10", {}, {{"law", "ogden"}}), "unknown preset law");
   expect_input_error(make_params("dragon_skin_10", {{"mu", {1.0}}}), "unknown key 'mu'");
+  expect_input_error(make_params("fabric", {{"mu", {1e5}}, {"nu", {0.3}}}), "fibre_modulus");
+  expect_input_error(make_params("fabric", {{"mu", {1e5}}, {"nu", {0.3}}, {"fibre_modulus", {-1e8}}}), "fibre modulus");
+  expect_input_error(
+      make_params("fabric", {{"mu", {1e5}}, {"nu", {0.3}}, {"fibre_modulus", {1e8}}, {"fibres", {1, 0, 0, 1}}}),
+      "3 numbers per fibre family");
+  expect_input_error(
+      make_params("fabric", {{"mu", {1e5}}, {"nu", {0.3}}, {"fibre_modulus", {1e8}}, {"fibres", {1, 0, 0, 0, 0, 0}}}),
+      "family 2 has no direction");
+  expect_input_error(make_params("fabric", {{"mu", {1e5}}, {"fibre_modulus", {1e8}}}), "give kappa [Pa] or nu");
+}
+
+// Fabric: stress and tangent against finite differences at states where no fibre is
+// within 1e-3 of going slack (the tangent jumps there), with the warp, the weft and an
+// oblique family; the tangent is checked relative to the fibre modulus.
+TEST(MaterialLaw, FabricStressAndTangentMatchFiniteDifferences) {
+  const double Ef = 1e8;
+  const auto m = make_material(make_params(
+      "fabric", {{"mu", {1e5}}, {"nu", {0.3}}, {"fibre_modulus", {Ef}}, {"fibres", {1, 0, 0, 0, 1, 0, 1, 1, 0}}}));
+  const std::vector<Eigen::Vector3d> fibres = {{1, 0, 0}, {0, 1, 0}, Eigen::Vector3d(1, 1, 0).normalized()};
+  int checked = 0, taut = 0;
+  for (const auto& [state, F] : test_states()) {
+    bool near_kink = false;
+    for (const auto& a : fibres) {
+      const double s = (F * a).squaredNorm() - 1.0;
+      near_kink = near_kink || std::abs(s) < 1e-3;
+      taut += s > 0;
+    }
+    if (near_kink) continue;
+    SCOPED_TRACE(state);
+    ++checked;
+    double W;
+    Mat3 P;
+    Tangent A;
+    m->evaluate(F, W, P, &A);
+    EXPECT_NEAR(W, m->energy(F), 1e-12 * (std::abs(W) + Ef));
+    EXPECT_LE((flatten(P) - fd_stress(*m, F, 1e-6)).cwiseAbs().maxCoeff(), 1e-7 * (P.cwiseAbs().maxCoeff() + Ef));
+    EXPECT_LE((A - fd_tangent(*m, F, 1e-6)).cwiseAbs().maxCoeff(), 1e-6 * Ef);
+    EXPECT_LE((A - A.transpose()).cwiseAbs().maxCoeff(), 1e-12 * A.cwiseAbs().maxCoeff());
+    // The split of material.h holds: W = W_iso + U(J).
+    double Wiso, U, dU, d2U;
+    Mat3 Piso;
+    m->evaluate_isochoric(F, Wiso, Piso, nullptr);
+    m->volumetric_energy(F.determinant(), U, dU, d2U);
+    EXPECT_NEAR(Wiso + U, W, 1e-10 * (std::abs(W) + Ef));
+  }
+  EXPECT_GE(checked, 8);
+  EXPECT_GE(taut, 10);  // the states stretch fibres, not only slacken them
+}
+
+// Uniaxial stress along the warp of a fabric with only warp fibres: the matrix's own
+// uniaxial stress plus the fibre's P11 = E_f / 2 (l^2 - 1) l in tension, and exactly the
+// matrix's in compression (the fibre buckles). The fibre leaves the lateral
+// equilibrium P22 = P33 = 0 unchanged, so the comparison is exact.
+TEST(MaterialLaw, FabricFibresCarryTensionOnly) {
+  const double Ef = 5e7;
+  const auto fabric = make_material(
+      make_params("fabric", {{"mu", {1e5}}, {"nu", {0.3}}, {"fibre_modulus", {Ef}}, {"fibres", {1, 0, 0}}}));
+  const auto matrix = make_material(make_params("neo_hookean", {{"mu", {1e5}}, {"nu", {0.3}}}));
+  for (double l : {1.01, 1.05, 1.2}) {
+    const double expected = uniaxial_P11(*matrix, l) + 0.5 * Ef * (l * l - 1.0) * l;
+    EXPECT_NEAR(uniaxial_P11(*fabric, l), expected, 1e-9 * expected) << "stretch " << l;
+  }
+  for (double l : {0.5, 0.8, 0.99}) EXPECT_NEAR(uniaxial_P11(*fabric, l), uniaxial_P11(*matrix, l), 1e-6) << l;
+  // Small strain: the warp's modulus is E_f plus the matrix's.
+  const double eps = 1e-6, E_matrix = 2 * 1e5 * 1.3;
+  EXPECT_NEAR(uniaxial_P11(*fabric, 1 + eps) / eps, Ef + E_matrix, 1e-4 * Ef);
+  EXPECT_EQ(fabric->energy(Eigen::Vector3d(1.0, 1.0, -0.5).asDiagonal()), std::numeric_limits<double>::infinity());
 }
 
 }  // namespace
