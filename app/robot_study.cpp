@@ -37,8 +37,9 @@ const char* kRobotUsage =
     "        the voxel study's baselines (hand-designed rolling and inching, flat and\n"
     "        15 deg hill, four empty schedules): voxel speed beside the finite-element\n"
     "        speed (voxel-study preset, growth actuation; --set keys, level L), wall time,\n"
-    "        dofs, steps, and beside the physical laminate with pressure actuation where\n"
-    "        its rolling slice applies (examples/physical/roll_slice.yaml; --set-physical)\n"
+    "        dofs, steps, and beside the physical laminate with pressure actuation (inflated:\n"
+    "        examples/physical/roll_slice.yaml, flat: examples/physical/inch_flat.yaml;\n"
+    "        --set-physical keys apply to both)\n"
     "  ladder --case NAME [--levels 0,1,2] [--out DIR]\n"
     "        one case on several fidelity levels: speed against wall time, and the\n"
     "        cheapest level within 5 % of the finest\n"
@@ -168,8 +169,9 @@ std::vector<RobotCase> voxel_baseline_cases(const std::string& dir) {
 std::vector<RobotCase> physical_baseline_cases(const std::string& dir) {
   std::vector<RobotCase> out;
   for (RobotCase c : voxel_baseline_cases(dir)) {
-    if (!(c.schedule.core_pressure_pa > 0) || c.schedule.orientation_deg != 0) continue;
-    c.template_scene = dir + "/examples/physical/roll_slice.yaml";
+    const bool inflated = c.schedule.core_pressure_pa > 0;
+    if (inflated && c.schedule.orientation_deg != 0) continue;
+    c.template_scene = dir + (inflated ? "/examples/physical/roll_slice.yaml" : "/examples/physical/inch_flat.yaml");
     c.physical = true;
     out.push_back(c);
   }
@@ -462,9 +464,9 @@ int validate(const std::vector<std::string>& args, MPI_Comm comm) {
     table += line;
   }
   table +=
-      "phys: the physical laminate's plane-strain rolling slice (examples/physical/roll_slice.yaml: core at the\n"
-      "50 kPa line pressure, chambers at the schedule's pressure); n/a: a cross-section cannot inch or move along\n"
-      "the body (heading 90 deg).\n";
+      "phys: the physical laminate with pressure actuation: inflated cases on its plane-strain rolling slice\n"
+      "(examples/physical/roll_slice.yaml, core at the 50 kPa line pressure), flat ones on the full-length body\n"
+      "(examples/physical/inch_flat.yaml); n/a: the inflated body heading along itself has no physical scene.\n";
   std::printf("fidelity %s: mesh %.4g m, P%d, max step %.4g s\n%s", level.name.c_str(), level.mesh_size, level.order,
               level.max_step, table.c_str());
   std::filesystem::create_directories(out_dir);

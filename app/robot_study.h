@@ -71,10 +71,14 @@ void set_scene_key(YAML::Node root, const std::string& assignment, const std::st
 // empty schedules. `source_dir` is the repository (templates in examples/voxel/).
 std::vector<RobotCase> voxel_baseline_cases(const std::string& source_dir);
 
-// The baseline cases the physical laminate's rolling slice can play: those with the
-// robot inflated (core > 0) and heading 0 (a plane-strain cross-section cannot move
-// along the body), i.e. roll_flat, roll_hill15 and empty_0deg_12kPa_flat, with the
-// inflated core at the template's line pressure (50 kPa) instead of 12 kPa.
+// The baseline cases the physical laminate can play, on two templates:
+//  * inflated (core > 0) at heading 0 on the rolling slice (examples/physical/
+//    roll_slice.yaml; a plane-strain cross-section cannot move along the body), the
+//    core at its line pressure (50 kPa) instead of 12 kPa: roll_flat, roll_hill15,
+//    empty_0deg_12kPa_flat;
+//  * flat (core 0) on the full-length body (examples/physical/inch_flat.yaml):
+//    inch_flat, inch_hill15, empty_0deg_0kPa_flat, empty_90deg_0kPa_hill15.
+// The inflated body heading 90 deg (empty_90deg_12kPa_hill15) has no physical scene.
 std::vector<RobotCase> physical_baseline_cases(const std::string& source_dir);
 
 // The schedule of a case as the lattice plays it: the voxel study's column length,

@@ -63,8 +63,9 @@ void add_physical_groups(const std::vector<SurfaceRule>& rules);
 
 // Meshes the synchronized current model in 3-D: target size mesh_size [m] at every
 // CAD point (a background size field can only refine below it), element order 1 or 2
-// with curved mid-nodes, deterministic single-threaded Delaunay.
-void generate_tet_mesh(double mesh_size, int order);
+// with curved mid-nodes, deterministic single-threaded Delaunay. A geometry gmsh cannot
+// mesh throws InputError(where, ...) with gmsh's reason.
+void generate_tet_mesh(double mesh_size, int order, const std::string& where = "geometry");
 // A fresh gmsh model for one build or file operation, removed when the scope ends
 // (also on errors).
 class ScopedGmshModel {

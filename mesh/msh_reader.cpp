@@ -285,7 +285,7 @@ ScopedGmshModel::ScopedGmshModel(const std::string& name) {
 
 ScopedGmshModel::~ScopedGmshModel() { gmsh::model::remove(); }
 
-void generate_tet_mesh(double mesh_size, int order) {
+void generate_tet_mesh(double mesh_size, int order, const std::string& where) {
   gmsh::option::setNumber("Mesh.MeshSizeMin", 0.0);
   gmsh::option::setNumber("Mesh.MeshSizeMax", mesh_size);
   gmsh::option::setNumber("Mesh.MeshSizeFromCurvature", 0);
@@ -296,7 +296,19 @@ void generate_tet_mesh(double mesh_size, int order) {
   gmsh::vectorpair points;
   gmsh::model::getEntities(points, 0);
   gmsh::model::mesh::setSize(points, mesh_size);
-  gmsh::model::mesh::generate(3);
+  // gmsh 4.8 throws std::string from inside its 3-D mesher (e.g. "Invalid boundary
+  // mesh (segment-facet intersection)" for some sizes on thin layers).
+  auto refuse = [&](const std::string& what) {
+    throw InputError(where, "gmsh could not mesh the geometry at mesh_size " + std::to_string(mesh_size) +
+                                " m (gmsh: " + what + "); a slightly different mesh_size usually meshes");
+  };
+  try {
+    gmsh::model::mesh::generate(3);
+  } catch (const std::string& e) {
+    refuse(e);
+  } catch (const std::exception& e) {
+    refuse(e.what());
+  }
 }
 
 void initialize_gmsh() {

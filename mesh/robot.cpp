@@ -109,7 +109,7 @@ Mesh mesh_assembly(const Assembly& assembly, double mesh_size, int order, const 
   std::vector<gmsh::vectorpair> unused_map;
   occ::fragment({boxes.front()}, gmsh::vectorpair(boxes.begin() + 1, boxes.end()), fragments, unused_map);
   occ::synchronize();
-  generate_tet_mesh(mesh_size, order);
+  generate_tet_mesh(mesh_size, order, source);
 
   const double tol = 1e-9 * assembly.scale, probe = 1e-6 * assembly.scale;
 

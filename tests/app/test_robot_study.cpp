@@ -4,6 +4,7 @@
 #include <petscsys.h>
 
 #include <cmath>
+#include <map>
 
 #include "actuation/voxel_growth.h"
 #include "app/robot_study.h"
@@ -70,7 +71,13 @@ TEST(RobotStudy, PhysicalCasesPlayTheBaselineScheduleOnTheRollingSlice) {
   const auto cases = physical_baseline_cases(MORPHFEM_SOURCE_DIR);
   std::vector<std::string> names;
   for (const auto& c : cases) names.push_back(c.name);
-  EXPECT_EQ(names, (std::vector<std::string>{"roll_flat", "roll_hill15", "empty_0deg_12kPa_flat"}));
+  EXPECT_EQ(names,
+            (std::vector<std::string>{"roll_flat", "roll_hill15", "inch_flat", "inch_hill15", "empty_0deg_12kPa_flat",
+                                      "empty_0deg_0kPa_flat", "empty_90deg_0kPa_hill15"}));
+  for (const auto& c : cases)
+    EXPECT_NE(c.template_scene.find(c.schedule.core_pressure_pa > 0 ? "roll_slice.yaml" : "inch_flat.yaml"),
+              std::string::npos)
+        << c.name;
   const RobotCase& hill = cases[1];
   ASSERT_TRUE(hill.physical);
   const YAML::Node doc = robot_scene_yaml(hill, find_robot_fidelity("2"), "");
@@ -95,6 +102,41 @@ TEST(RobotStudy, PhysicalCasesPlayTheBaselineScheduleOnTheRollingSlice) {
   EXPECT_NEAR(b8->pressure(t2), 0, 1e-6);
   EXPECT_NEAR(core->pressure(t1), 50000, 1e-6);
   EXPECT_EQ(b8->open_axis, 1);
+}
+
+// The flat cases play on the full-length body: inching on the hill has the body length
+// uphill, the top chambers on in the odd columns at 35 kPa, foot B gripping (0.70) and
+// foot A sliding (0.56) in them, the other way round in the even columns.
+TEST(RobotStudy, PhysicalInchingCasesPlayOnTheFullLengthBody) {
+  const auto cases = physical_baseline_cases(MORPHFEM_SOURCE_DIR);
+  const RobotCase* inch = nullptr;
+  for (const auto& c : cases)
+    if (c.name == "inch_hill15") inch = &c;
+  ASSERT_TRUE(inch && inch->physical);
+  const YAML::Node doc = robot_scene_yaml(*inch, find_robot_fidelity("2"), "");
+  EXPECT_EQ(doc["geometry"]["mesh_size"].as<double>(), 0.01);  // the template's
+  const Scene scene = scene_from_yaml(doc, inch->template_scene);
+  ASSERT_TRUE(scene.gait.enabled);
+  EXPECT_NEAR(scene.gravity.y(), -9.80665 * std::sin(15 * M_PI / 180), 1e-9);  // the body length uphill
+  EXPECT_NEAR(scene.gravity.x(), 0.0, 1e-12);
+  const double odd = scene.gait.start + 0.9 * inch->schedule.column_s, even = odd + inch->schedule.column_s;
+  int chambers = 0;
+  for (const auto& cav : scene.cavities) {
+    if (cav.name == "core") ADD_FAILURE() << "the flat body has no pressurised core";
+    const bool top = cav.name == "b1" || cav.name == "b2" || cav.name == "b3" || cav.name == "b4";
+    EXPECT_NEAR(cav.pressure(odd), top ? 35000 : 0, 1e-6) << cav.name;
+    EXPECT_NEAR(cav.pressure(even), 0, 1e-6) << cav.name;
+    ++chambers;
+  }
+  EXPECT_EQ(chambers, 8);
+  ASSERT_TRUE(scene.friction);
+  std::map<std::string, const FrictionRegion*> regions;
+  for (const auto& r : scene.friction_spec.regions) regions[r.surface] = &r;
+  ASSERT_TRUE(regions.count("foot_a") && regions.count("foot_b"));
+  EXPECT_NEAR(regions["foot_b"]->mu_static(odd), 0.70, 1e-9);
+  EXPECT_NEAR(regions["foot_a"]->mu_static(odd), 0.56, 1e-9);
+  EXPECT_NEAR(regions["foot_b"]->mu_static(even), 0.56, 1e-9);
+  EXPECT_NEAR(regions["foot_a"]->mu_static(even), 0.70, 1e-9);
 }
 
 // --set: keys set last, '*' over a mapping's keys, a new last key; bad paths and
