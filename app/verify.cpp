@@ -46,6 +46,14 @@ ParamSet verification_params(std::initializer_list<std::pair<const char*, double
   return p;
 }
 
+ParamSet cube_geometry(double L, double h, int order, bool structured, double distort) {
+  ParamSet p = verification_params({{"lx", L}, {"ly", L}, {"lz", L}, {"mesh_size", h}, {"order", double(order)}},
+                                   "type", "block");
+  if (structured) p.set("structured", 1.0);
+  if (distort > 0) p.set("distort", distort);
+  return p;
+}
+
 Scene verification_scene(const std::string& name, ParamSet geometry, ParamSet material) {
   Scene s;
   s.name = name;
@@ -105,6 +113,17 @@ Mat3 cell_F(const Mesh& mesh, const RowMatrixXd& u, int c, const Eigen::Vector3d
   return Mat3::Identity() + G;
 }
 
+// Prescribes every component of u = field(X, t) on the six faces of a block mesh.
+void prescribe_on_block_faces(Scene& s, const std::function<Eigen::Vector3d(const Eigen::Vector3d&, double)>& field) {
+  for (const char* face : {"xmin", "xmax", "ymin", "ymax", "zmin", "zmax"}) {
+    BoundarySpec b;
+    b.surface = face;
+    b.components = {true, true, true};
+    b.field = field;
+    s.boundary.push_back(b);
+  }
+}
+
 // ---------------------------------------------------------------- case 1: patch test
 // Affine u = (F - I) X imposed on the whole boundary of a distorted block: the
 // discrete solution must be exactly affine (nodes and F in every cell).
@@ -116,20 +135,10 @@ void patch_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<Verificatio
   for (int order : {1, 2})
     for (size_t level = 0; level < divisions.size(); ++level) {
       const double h = L / divisions[level];
-      Scene s = verification_scene(
-          "patch",
-          verification_params(
-              {{"lx", L}, {"ly", L}, {"lz", L}, {"mesh_size", h}, {"order", double(order)}, {"distort", 0.25}}, "type",
-              "block"),
-          verification_params({{"mu", 1e5}, {"kappa", 5e5}}, "model", "neo_hookean"));
+      Scene s = verification_scene("patch", cube_geometry(L, h, order, false, 0.25),
+                                   verification_params({{"mu", 1e5}, {"kappa", 5e5}}, "model", "neo_hookean"));
       const Mat3 G = F - Mat3::Identity();
-      for (const char* face : {"xmin", "xmax", "ymin", "ymax", "zmin", "zmax"}) {
-        BoundarySpec b;
-        b.surface = face;
-        b.components = {true, true, true};
-        b.field = [G](const Eigen::Vector3d& X, double t) { return Eigen::Vector3d(t * G * X); };
-        s.boundary.push_back(b);
-      }
+      prescribe_on_block_faces(s, [G](const Eigen::Vector3d& X, double t) { return Eigen::Vector3d(t * G * X); });
       s.solver.t_end = 1.0;
       s.solver.dt_initial = 0.5;
       auto r = run_scene(s, comm, {false, opt.progress, {}});
@@ -200,19 +209,8 @@ void mms_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<VerificationR
     double prev_L2 = 0, prev_H1 = 0, prev_h = 0;
     for (size_t level = 0; level < divisions.size(); ++level) {
       const double h = L / divisions[level];
-      Scene s = verification_scene(
-          "mms",
-          verification_params(
-              {{"lx", L}, {"ly", L}, {"lz", L}, {"mesh_size", h}, {"order", double(order)}, {"structured", 1}}, "type",
-              "block"),
-          material);
-      for (const char* face : {"xmin", "xmax", "ymin", "ymax", "zmin", "zmax"}) {
-        BoundarySpec b;
-        b.surface = face;
-        b.components = {true, true, true};
-        b.field = [m](const Eigen::Vector3d& X, double t) { return Eigen::Vector3d(t * m.u(X)); };
-        s.boundary.push_back(b);
-      }
+      Scene s = verification_scene("mms", cube_geometry(L, h, order, true), material);
+      prescribe_on_block_faces(s, [m](const Eigen::Vector3d& X, double t) { return Eigen::Vector3d(t * m.u(X)); });
       s.body_force = [body_force](const Eigen::Vector3d& X, double t) { return Eigen::Vector3d(t * body_force(X, t)); };
       s.body_force_degree = 6;
       s.solver.t_end = 1.0;
@@ -394,9 +392,9 @@ void cantilever_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<Verifi
 // bottom face; time step dt up to t_end.
 Scene sliding_block_scene(const std::string& name, const TimeFunction& mu, double eps_v, double t_end, double dt) {
   const double g = 9.8, slope = std::atan(0.5), L = 0.02, dhat = 1e-5;
-  Scene s = verification_scene(
-      name, verification_params({{"lx", L}, {"ly", L}, {"lz", L}, {"mesh_size", L / 2}, {"order", 1}}, "type", "block"),
-      verification_params({{"mu", 1e7}, {"nu", 0.3}, {"density", 1000}}, "model", "neo_hookean"));
+  Scene s =
+      verification_scene(name, cube_geometry(L, L / 2, 1),
+                         verification_params({{"mu", 1e7}, {"nu", 0.3}, {"density", 1000}}, "model", "neo_hookean"));
   s.gravity = Eigen::Vector3d(g * std::sin(slope), 0, -g * std::cos(slope));
   s.dynamic = true;
   s.inertia.scheme = TimeScheme::implicit_euler;

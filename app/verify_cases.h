@@ -18,6 +18,9 @@ using VerificationCase = std::function<void(const VerifyOptions&, MPI_Comm, std:
 // A ParamSet from numbers, with an optional text entry (e.g. "type", "block").
 ParamSet verification_params(std::initializer_list<std::pair<const char*, double>> numbers,
                              const char* text_key = nullptr, const char* text = nullptr);
+// The block [0, L]^3 at mesh size h [m] and element order, structured (a regular
+// tetrahedral grid) or not, its interior nodes moved by `distort` (fraction of h).
+ParamSet cube_geometry(double L, double h, int order, bool structured = false, double distort = 0.0);
 // A scene with one volume region "body" of the given material.
 Scene verification_scene(const std::string& name, ParamSet geometry, ParamSet material);
 // A record filled with the run's cost (dofs, wall time, Newton iterations, steps, cuts).

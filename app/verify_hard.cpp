@@ -296,11 +296,7 @@ void incompressible_block_case(const VerifyOptions& opt, MPI_Comm comm, std::vec
 
   {  // (1) homogeneous uniaxial tension
     const double stretch = 1.5, h = L / 2;
-    Scene s = verification_scene(
-        "block_uniaxial",
-        verification_params({{"lx", L}, {"ly", L}, {"lz", L}, {"mesh_size", h}, {"order", 2}, {"structured", 1}},
-                            "type", "block"),
-        material);
+    Scene s = verification_scene("block_uniaxial", cube_geometry(L, h, 2, true), material);
     s.formulation = "mean_dilatation";
     BoundarySpec top = fixed("zmax", false, false, true);
     top.displacement = Eigen::Vector3d(0, 0, (stretch - 1.0) * L);
@@ -327,11 +323,7 @@ void incompressible_block_case(const VerifyOptions& opt, MPI_Comm comm, std::vec
     for (int n : divisions) {
       if (formulation == "displacement" && n > 4) continue;  // locks; 109 s at n = 6 for no new information
       const double h = L / n;
-      Scene s = verification_scene(
-          "block_shear",
-          verification_params({{"lx", L}, {"ly", L}, {"lz", L}, {"mesh_size", h}, {"order", 2}, {"structured", 1}},
-                              "type", "block"),
-          material);
+      Scene s = verification_scene("block_shear", cube_geometry(L, h, 2, true), material);
       s.formulation = formulation;
       s.boundary = {fixed("zmin", true, true, true)};
       TractionSpec shear;
@@ -383,11 +375,7 @@ void compression_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<Verif
   std::shared_ptr<const Material> law = make_material(material);
   const std::string formulation = "mean_dilatation";
   auto scene = [&](double h, bool bonded) {
-    Scene s = verification_scene(
-        "compression",
-        verification_params({{"lx", L}, {"ly", L}, {"lz", L}, {"mesh_size", h}, {"order", 2}, {"structured", 1}},
-                            "type", "block"),
-        material);
+    Scene s = verification_scene("compression", cube_geometry(L, h, 2, true), material);
     s.formulation = formulation;
     BoundarySpec top = fixed("zmax", bonded, bonded, true);
     top.displacement = Eigen::Vector3d(0, 0, -0.5 * L);
