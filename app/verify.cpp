@@ -206,7 +206,7 @@ void mms_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<VerificationR
   std::map<int, std::vector<int>> ladder = opt.quick ? std::map<int, std::vector<int>>{{1, {2, 4}}, {2, {2, 4}}}
                                                      : std::map<int, std::vector<int>>{{1, {4, 8, 16}}, {2, {2, 4, 8}}};
   for (auto& [order, divisions] : ladder) {
-    double prev_L2 = 0, prev_H1 = 0, prev_h = 0;
+    ConvergenceRate rates[2];  // L2, H1
     for (size_t level = 0; level < divisions.size(); ++level) {
       const double h = L / divisions[level];
       Scene s = verification_scene("mms", cube_geometry(L, h, order, true), material);
@@ -239,13 +239,9 @@ void mms_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<VerificationR
         rec.value = which == 0 ? L2 : H1;
         rec.reference = 0;
         rec.rel_error = rec.value;
-        const double prev = which == 0 ? prev_L2 : prev_H1;
-        if (level > 0) rec.rate = std::log(prev / rec.value) / std::log(prev_h / h);
+        rec.rate = rates[which].next(rec.value, h);
         out.push_back(rec);
       }
-      prev_L2 = L2;
-      prev_H1 = H1;
-      prev_h = h;
     }
   }
 }
@@ -420,7 +416,7 @@ void slope_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<Verificatio
   const double reference = 0.5 * g * (std::sin(slope) - mu * std::cos(slope)) * T * T;
   const double L = 0.02;
   std::vector<double> steps = opt.quick ? std::vector<double>{0.05, 0.025} : std::vector<double>{0.05, 0.025, 0.0125};
-  double prev_error = 0, prev_dt = 0;
+  ConvergenceRate rate;
   for (size_t level = 0; level < steps.size(); ++level) {
     const double dt = steps[level];
     Scene s = sliding_block_scene("slope", TimeFunction::constant(mu), 1e-4, T, dt);
@@ -434,9 +430,7 @@ void slope_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<Verificatio
     rec.value = slide;
     rec.reference = reference;
     rec.rel_error = std::abs(slide - reference) / reference;
-    if (level > 0) rec.rate = std::log(prev_error / rec.rel_error) / std::log(prev_dt / dt);
-    prev_error = rec.rel_error;
-    prev_dt = dt;
+    rec.rate = rate.next(rec.rel_error, dt);
     out.push_back(rec);
   }
 }
@@ -452,7 +446,7 @@ void friction_switch_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<V
   const double reference = 0.5 * a1 + a1 * a1 / (2 * std::abs(a2));
   const TimeFunction mu({{0.0, 0.9}, {1.0, 0.9}, {1.0 + 1e-6, 0.2}, {2.0, 0.2}, {2.0 + 1e-6, 0.9}});
   std::vector<double> steps = opt.quick ? std::vector<double>{0.02} : std::vector<double>{0.02, 0.01, 0.005};
-  double prev_error = 0, prev_dt = 0;
+  ConvergenceRate rate;
   for (size_t level = 0; level < steps.size(); ++level) {
     const double dt = steps[level];
     Scene s = sliding_block_scene("friction_switch", mu, 1e-5, T, dt);
@@ -470,9 +464,7 @@ void friction_switch_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<V
     rec.value = slide;
     rec.reference = reference;
     rec.rel_error = std::abs(slide - reference) / reference;
-    if (level > 0) rec.rate = std::log(prev_error / rec.rel_error) / std::log(prev_dt / dt);
-    prev_error = rec.rel_error;
-    prev_dt = dt;
+    rec.rate = rate.next(rec.rel_error, dt);
     out.push_back(rec);
     auto still = verification_record("friction_switch", "creep [m] while mu = 0.9 (t < 1 s)", int(level), 1, L / 2, r);
     still.value = slide_at_1;

@@ -3,6 +3,7 @@
 // stress the solver (near-incompressibility, limit points, large rotations,
 // contact) are "hard" and run with `morphfem verify --hard`.
 #pragma once
+#include <cmath>
 #include <functional>
 #include <string>
 #include <vector>
@@ -21,6 +22,22 @@ ParamSet verification_params(std::initializer_list<std::pair<const char*, double
 // The block [0, L]^3 at mesh size h [m] and element order, structured (a regular
 // tetrahedral grid) or not, its interior nodes moved by `distort` (fraction of h).
 ParamSet cube_geometry(double L, double h, int order, bool structured = false, double distort = 0.0);
+// The observed order of convergence along a ladder of levels:
+// rate = log(e_prev / e) / log(h_prev / h) [-], h the mesh size or time step; next()
+// returns it for the new level and remembers the level; 0 at the first level and where
+// an error is 0.
+class ConvergenceRate {
+ public:
+  double next(double error, double h) {
+    const double rate = error_ > 0 && error > 0 && h_ > 0 ? std::log(error_ / error) / std::log(h_ / h) : 0.0;
+    error_ = error;
+    h_ = h;
+    return rate;
+  }
+
+ private:
+  double error_ = 0, h_ = 0;
+};
 // A scene with one volume region "body" of the given material.
 Scene verification_scene(const std::string& name, ParamSet geometry, ParamSet material);
 // A record filled with the run's cost (dofs, wall time, Newton iterations, steps, cuts).

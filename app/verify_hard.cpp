@@ -261,7 +261,7 @@ void cook_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<Verification
     ladders.push_back({2, "mean_dilatation", {2, 4, 8, 16, 32}});
   }
   for (const auto& ladder : ladders) {
-    double prev_err = 0, prev_h = 0;
+    ConvergenceRate rate;
     for (size_t level = 0; level < ladder.divisions.size(); ++level) {
       const double h = 0.048 / ladder.divisions[level];
       CookResult r = run_cook(ladder.divisions[level], ladder.order, ladder.formulation, mu, kappa, opt.progress, comm);
@@ -270,10 +270,7 @@ void cook_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<Verification
       rec.value = r.tip_mm;
       rec.reference = kCookReference_mm;
       rec.rel_error = rel_error(r.tip_mm, kCookReference_mm);
-      if (level > 0 && prev_err > 0 && rec.rel_error > 0)
-        rec.rate = std::log(prev_err / rec.rel_error) / std::log(prev_h / h);
-      prev_err = rec.rel_error;
-      prev_h = h;
+      rec.rate = rate.next(rec.rel_error, h);
       out.push_back(rec);
     }
   }

@@ -307,7 +307,7 @@ TubeVacuumResult run_tube_vacuum(double h, int order, MPI_Comm comm, bool progre
 void tube_vacuum_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<VerificationRecord>& out) {
   const std::vector<double> sizes = opt.quick ? std::vector<double>{1e-3} : std::vector<double>{1e-3, 0.75e-3, 0.5e-3};
   const int order = 2;
-  double prev_error = 0, prev_h = 0;
+  ConvergenceRate rate;
   for (size_t level = 0; level < sizes.size(); ++level) {
     const double h = sizes[level];
     TubeVacuumResult t;
@@ -331,10 +331,7 @@ void tube_vacuum_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<Verif
     }
     auto ratio = record("contact pressure / vacuum in the flattened region", t.pressure_ratio, 1.0,
                         std::abs(t.pressure_ratio - 1.0));
-    if (level > 0 && ratio.rel_error > 0 && prev_error > 0)
-      ratio.rate = std::log(prev_error / ratio.rel_error) / std::log(prev_h / h);
-    prev_error = ratio.rel_error;
-    prev_h = h;
+    ratio.rate = rate.next(ratio.rel_error, h);
     out.push_back(ratio);
     // Pass/fail checks over every converged step: rel_error 0 if it holds, 1 if not.
     out.push_back(record("min face distance over all steps [m] (brute force, must be > 0)", t.min_distance, 0.0,
