@@ -12,84 +12,65 @@ std::vector<int> owned_faces(const Mesh& mesh, const Partition& partition, int r
   return out;
 }
 
-BodyForceTerm::BodyForceTerm(const Mesh& mesh, const Partition& partition, int rank, const std::vector<int>& cells,
-                             VectorField body_force, int quadrature_degree)
-    : mesh_(mesh), force_(std::move(body_force)) {
+namespace {
+
+std::vector<int> owned_cells(const Partition& partition, int rank, const std::vector<int>& cells) {
+  std::vector<int> out;
   for (int c : cells)
-    if (partition.cell_part[c] == rank) cells_.push_back(c);
-  table_ = make_tet_table(mesh.order, quadrature_degree);
+    if (partition.cell_part[c] == rank) out.push_back(c);
+  return out;
+}
+
+}  // namespace
+
+DeadLoadTerm::DeadLoadTerm(const Mesh& mesh, Entity kind, std::vector<int> entities, VectorField field,
+                           ShapeTable table)
+    : mesh_(mesh), kind_(kind), entities_(std::move(entities)), field_(std::move(field)), table_(std::move(table)) {
   set_time(0.0);
 }
 
-void BodyForceTerm::piece_nodes(int k, std::vector<int>& nodes) const {
-  const int c = cells_[k];
-  nodes.assign(mesh_.cells.row(c).data(), mesh_.cells.row(c).data() + mesh_.nodes_per_cell());
-}
-
-// Nodal forces f_a = int_V N_a b(X, t) dV [N] of every owned cell.
-void BodyForceTerm::set_time(double t) {
-  if (t == time_ && nodal_force_.size() == cells_.size()) return;
-  time_ = t;
-  nodal_force_.resize(cells_.size());
-  const int n = mesh_.nodes_per_cell();
-  Eigen::MatrixXd X(n, 3);
-  for (size_t k = 0; k < cells_.size(); ++k) {
-    for (int a = 0; a < n; ++a) X.row(a) = mesh_.X.row(mesh_.cells(cells_[k], a));
-    Eigen::VectorXd& f = nodal_force_[k];
-    f.setZero(3 * n);
-    for (size_t q = 0; q < table_.points.size(); ++q) {
-      const Eigen::VectorXd& N = table_.N[q];
-      const Eigen::Matrix3d J0 = X.transpose() * table_.dN[q];
-      const double dV = table_.points[q].weight * J0.determinant();
-      const Eigen::Vector3d b = force_(X.transpose() * N, t);
-      for (int a = 0; a < n; ++a) f.segment<3>(3 * a) += dV * N[a] * b;
-    }
-  }
-}
-
-double BodyForceTerm::piece(int k, const PieceState& s, Eigen::VectorXd* g, Eigen::MatrixXd* H) const {
-  const int n = static_cast<int>(s.X.rows());
-  const Eigen::VectorXd& f = nodal_force_.at(k);
-  if (g) *g = -f;
-  if (H) H->setZero(3 * n, 3 * n);
-  return -f.dot(Eigen::Map<const Eigen::VectorXd>(Eigen::MatrixXd(s.u.transpose()).data(), 3 * n));
-}
+BodyForceTerm::BodyForceTerm(const Mesh& mesh, const Partition& partition, int rank, const std::vector<int>& cells,
+                             VectorField body_force, int quadrature_degree)
+    : DeadLoadTerm(mesh, Entity::cell, owned_cells(partition, rank, cells), std::move(body_force),
+                   make_tet_table(mesh.order, quadrature_degree)) {}
 
 SurfaceLoadTerm::SurfaceLoadTerm(const Mesh& mesh, const Partition& partition, int rank, const std::vector<int>& faces,
                                  VectorField traction)
-    : mesh_(mesh), faces_(owned_faces(mesh, partition, rank, faces)), traction_(std::move(traction)) {
-  table_ = make_triangle_table(mesh.order, 2 * mesh.order);
-  set_time(0.0);
+    : DeadLoadTerm(mesh, Entity::face, owned_faces(mesh, partition, rank, faces), std::move(traction),
+                   make_triangle_table(mesh.order, 2 * mesh.order)) {}
+
+void DeadLoadTerm::piece_nodes(int k, std::vector<int>& nodes) const {
+  const auto& rows = kind_ == Entity::cell ? mesh_.cells : mesh_.faces;
+  const int e = entities_[k];
+  nodes.assign(rows.row(e).data(), rows.row(e).data() + rows.cols());
 }
 
-void SurfaceLoadTerm::piece_nodes(int k, std::vector<int>& nodes) const {
-  const int f = faces_[k];
-  nodes.assign(mesh_.faces.row(f).data(), mesh_.faces.row(f).data() + mesh_.nodes_per_face());
-}
-
-// Nodal forces f_a = int_S N_a t(X, t) dA [N] (reference area) of every owned face.
-void SurfaceLoadTerm::set_time(double t) {
-  if (t == time_ && nodal_force_.size() == faces_.size()) return;
+// Nodal forces f_a = sum_q w_q N_a(q) v(X(q), t) dm(q) [N] of every owned entity, with
+// dm = det(dX/dxi) for a cell and |dX/dxi_1 x dX/dxi_2| for a face (reference measures).
+void DeadLoadTerm::set_time(double t) {
+  if (t == time_ && nodal_force_.size() == entities_.size()) return;
   time_ = t;
-  nodal_force_.resize(faces_.size());
-  const int n = mesh_.nodes_per_face();
+  nodal_force_.resize(entities_.size());
+  const auto& rows = kind_ == Entity::cell ? mesh_.cells : mesh_.faces;
+  const int n = static_cast<int>(rows.cols());
   Eigen::MatrixXd X(n, 3);
-  for (size_t k = 0; k < faces_.size(); ++k) {
-    for (int a = 0; a < n; ++a) X.row(a) = mesh_.X.row(mesh_.faces(faces_[k], a));
+  for (size_t k = 0; k < entities_.size(); ++k) {
+    for (int a = 0; a < n; ++a) X.row(a) = mesh_.X.row(rows(entities_[k], a));
     Eigen::VectorXd& f = nodal_force_[k];
     f.setZero(3 * n);
     for (size_t q = 0; q < table_.points.size(); ++q) {
       const Eigen::VectorXd& N = table_.N[q];
-      const Eigen::MatrixXd& dN = table_.dN[q];
-      const Eigen::Vector3d a = X.transpose() * dN.col(0), b = X.transpose() * dN.col(1);
-      const double dA = table_.points[q].weight * a.cross(b).norm();
-      const Eigen::Vector3d traction = traction_(X.transpose() * N, t);
-      for (int c = 0; c < n; ++c) f.segment<3>(3 * c) += dA * N[c] * traction;
+      const Eigen::MatrixXd tangents = X.transpose() * table_.dN[q];  // 3 x dim
+      const double measure = kind_ == Entity::cell
+                                 ? Eigen::Matrix3d(tangents).determinant()
+                                 : Eigen::Vector3d(tangents.col(0)).cross(Eigen::Vector3d(tangents.col(1))).norm();
+      const Eigen::Vector3d v = field_(X.transpose() * N, t);
+      for (int a = 0; a < n; ++a) f.segment<3>(3 * a) += table_.points[q].weight * measure * N[a] * v;
     }
   }
 }
 
-double SurfaceLoadTerm::piece(int k, const PieceState& s, Eigen::VectorXd* g, Eigen::MatrixXd* H) const {
+double DeadLoadTerm::piece(int k, const PieceState& s, Eigen::VectorXd* g, Eigen::MatrixXd* H) const {
   const int n = static_cast<int>(s.X.rows());
   const Eigen::VectorXd& f = nodal_force_.at(k);
   if (g) *g = -f;

@@ -16,44 +16,44 @@ namespace morphfem {
 
 using VectorField = std::function<Eigen::Vector3d(const Eigen::Vector3d& X, double t)>;
 
-// Pieces: the given cells that partition part `rank` owns.
-class BodyForceTerm : public EnergyTerm {
+// The shared part of both: pieces are mesh entities (cells or boundary faces), each
+// with nodal forces f_a = int N_a v(X, t) dm [N] (dm = dV or the reference dA) that
+// set_time recomputes when t changes.
+class DeadLoadTerm : public EnergyTerm {
  public:
-  BodyForceTerm(const Mesh& mesh, const Partition& partition, int rank, const std::vector<int>& cells,
-                VectorField body_force, int quadrature_degree);
-  std::string name() const override { return "body_force"; }
-  int n_pieces() const override { return static_cast<int>(cells_.size()); }
+  int n_pieces() const override { return static_cast<int>(entities_.size()); }
   void piece_nodes(int k, std::vector<int>& nodes) const override;
   double piece(int k, const PieceState& s, Eigen::VectorXd* g, Eigen::MatrixXd* H) const override;
   void set_time(double t) override;
 
+ protected:
+  enum class Entity { cell, face };
+  DeadLoadTerm(const Mesh& mesh, Entity kind, std::vector<int> entities, VectorField field, ShapeTable table);
+
  private:
   const Mesh& mesh_;
-  std::vector<int> cells_;
-  VectorField force_;
+  Entity kind_;
+  std::vector<int> entities_;
+  VectorField field_;
   ShapeTable table_;
   double time_ = -1.0;
   std::vector<Eigen::VectorXd> nodal_force_;  // per piece, 3n [N]
 };
 
-// Pieces: the given boundary faces whose first node this rank owns.
-class SurfaceLoadTerm : public EnergyTerm {
+// Pieces: the given cells that partition part `rank` owns; b [N/m^3].
+class BodyForceTerm final : public DeadLoadTerm {
+ public:
+  BodyForceTerm(const Mesh& mesh, const Partition& partition, int rank, const std::vector<int>& cells,
+                VectorField body_force, int quadrature_degree);
+  std::string name() const override { return "body_force"; }
+};
+
+// Pieces: the given boundary faces whose first node this rank owns; t [Pa].
+class SurfaceLoadTerm final : public DeadLoadTerm {
  public:
   SurfaceLoadTerm(const Mesh& mesh, const Partition& partition, int rank, const std::vector<int>& faces,
                   VectorField traction);
   std::string name() const override { return "surface_load"; }
-  int n_pieces() const override { return static_cast<int>(faces_.size()); }
-  void piece_nodes(int k, std::vector<int>& nodes) const override;
-  double piece(int k, const PieceState& s, Eigen::VectorXd* g, Eigen::MatrixXd* H) const override;
-  void set_time(double t) override;
-
- private:
-  const Mesh& mesh_;
-  std::vector<int> faces_;
-  VectorField traction_;
-  ShapeTable table_;
-  double time_ = -1.0;
-  std::vector<Eigen::VectorXd> nodal_force_;  // per piece, 3n [N]
 };
 
 // The faces among `faces` that rank `rank` assembles (owner of the face's first node).
