@@ -55,9 +55,9 @@ const char* kRobotUsage =
     "        pulled at the scene's speed with its feet inflated and deflated; force against\n"
     "        crosshead travel as exports `calibrate pull-tests` reads, their coefficients, PNG\n"
     "        (foot states spread over the MPI ranks)\n"
-    "  benchmark [--fidelity L]\n"
+    "  benchmark [--fidelity L] [--presets voxel,physical]\n"
     "        wall time of each hand-designed gait (19.8 s) on one rank, beside the voxel\n"
-    "        simulator's 136-145 s on this machine\n"
+    "        simulator's 136-145 s on this machine (physical: the templates' own meshes)\n"
     "  levels    the fidelity levels\n"
     "--set KEY=VALUE (repeatable) sets a scene key last, e.g. --set geometry.order=2 or\n"
     "  --set 'materials.bladder_*.density=15000' (a key ending in '*': every key with that prefix)\n"
@@ -611,15 +611,16 @@ int friction_sweep(const std::vector<std::string>& args, MPI_Comm comm) {
 }
 
 int benchmark(const std::vector<std::string>& args, MPI_Comm comm) {
-  check_options(args, {"--fidelity"});
+  check_options(args, {"--fidelity", "--presets"});
   int size = 1;
   MPI_Comm_size(comm, &size);
   if (size != 1) throw InputError("morphfem robot benchmark", "times one rank per gait: run it without mpirun");
   const std::string level = option(args, "--fidelity", "0");
   std::printf("voxel simulator (Voxelyze, 1428 voxels, 186,719 explicit steps, one thread): 136-145 s per gait\n");
-  return validate({"validate", "--fidelity", level, "--cases", "roll_flat,roll_hill15,inch_flat,inch_hill15", "--out",
-                   "results/robot/benchmark_L" + level},
-                  comm);
+  return validate(
+      {"validate", "--fidelity", level, "--cases", "roll_flat,roll_hill15,inch_flat,inch_hill15", "--presets",
+       option(args, "--presets", "voxel,physical"), "--out", "results/robot/benchmark_L" + level},
+      comm);
 }
 
 int morph(const std::vector<std::string>& args, MPI_Comm comm) {
