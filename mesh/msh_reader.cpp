@@ -299,8 +299,10 @@ void generate_tet_mesh(double mesh_size, int order, const std::string& where) {
   // gmsh 4.8 throws std::string from inside its 3-D mesher (e.g. "Invalid boundary
   // mesh (segment-facet intersection)" for some sizes on thin layers).
   auto refuse = [&](const std::string& what) {
-    throw InputError(where, "gmsh could not mesh the geometry at mesh_size " + std::to_string(mesh_size) +
-                                " m (gmsh: " + what + "); a slightly different mesh_size usually meshes");
+    std::ostringstream size;
+    size << mesh_size;
+    throw InputError(where, "gmsh could not mesh the geometry at mesh_size " + size.str() + " m (gmsh: " + what +
+                                "); a slightly different mesh_size usually meshes");
   };
   try {
     gmsh::model::mesh::generate(3);
