@@ -1,8 +1,8 @@
 // Independent runs spread over the ranks of an MPI communicator: job j runs on rank
-// j mod size (round robin, one rank per job, each on PETSC_COMM_SELF), writes a row
-// of `fields` numbers, and every rank gets every row back (one MPI_Allreduce of the
-// disjoint rows). Used by the commands that run several scenes at once (robot
-// validate / ladder / friction-sweep, robot friction-drag).
+// j mod size (round robin, one rank per job; the job runs its scene on
+// PETSC_COMM_SELF), writes a row of `fields` numbers, and every rank gets every row
+// back (one MPI_Allreduce of the disjoint rows). Used by the commands that run several
+// scenes at once (robot validate / ladder / friction-sweep, robot friction-drag).
 #pragma once
 #include <mpi.h>
 

@@ -32,38 +32,33 @@ class Fabric final : public Material {
   double bulk_modulus() const override { return matrix_->bulk_modulus(); }
 
   double energy(const Mat3& F) const override {
-    const double W = matrix_->energy(F);
-    return std::isfinite(W) ? W + fibre_energy(F) : W;
+    double W = matrix_->energy(F);
+    if (std::isfinite(W)) add_fibres(F, W, nullptr, nullptr);
+    return W;
   }
   void evaluate(const Mat3& F, double& W, Mat3& P, Tangent* A) const override {
     matrix_->evaluate(F, W, P, A);
-    add_fibres(F, W, P, A);
+    add_fibres(F, W, &P, A);
   }
   void evaluate_isochoric(const Mat3& F, double& W, Mat3& P, Tangent* A) const override {
     matrix_->evaluate_isochoric(F, W, P, A);
-    add_fibres(F, W, P, A);
+    add_fibres(F, W, &P, A);
   }
   void volumetric_energy(double J, double& U, double& dU, double& d2U) const override {
     matrix_->volumetric_energy(J, U, dU, d2U);
   }
 
  private:
-  double fibre_energy(const Mat3& F) const {
-    double W = 0.0;
-    for (const auto& a : fibres_) {
-      const double stretch = (F * a).squaredNorm() - 1.0;  // I4 - 1
-      if (stretch > 0) W += 0.125 * modulus_ * stretch * stretch;
-    }
-    return W;
-  }
-  void add_fibres(const Mat3& F, double& W, Mat3& P, Tangent* A) const {
+  // Adds the taut fibres' W and, where asked for (P, A not null), their P and A.
+  void add_fibres(const Mat3& F, double& W, Mat3* P, Tangent* A) const {
     for (const auto& a : fibres_) {
       const Eigen::Vector3d Fa = F * a;
-      const double stretch = Fa.squaredNorm() - 1.0;
-      if (!(stretch > 0)) continue;  // slack fibre: no energy, stress or stiffness
+      const double stretch = Fa.squaredNorm() - 1.0;  // I4 - 1
+      if (!(stretch > 0)) continue;                   // slack fibre: no energy, stress or stiffness
       W += 0.125 * modulus_ * stretch * stretch;
+      if (P == nullptr) continue;
       const Mat3 dI4 = Fa * a.transpose();  // half of d I4 / dF
-      P += 0.5 * modulus_ * stretch * dI4;
+      *P += 0.5 * modulus_ * stretch * dI4;
       if (A == nullptr) continue;
       const Vec9 g = flatten(dI4);
       *A += modulus_ * g * g.transpose();

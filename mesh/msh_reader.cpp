@@ -296,8 +296,9 @@ void generate_tet_mesh(double mesh_size, int order, const std::string& where) {
   gmsh::vectorpair points;
   gmsh::model::getEntities(points, 0);
   gmsh::model::mesh::setSize(points, mesh_size);
-  // gmsh 4.8 throws std::string from inside its 3-D mesher (e.g. "Invalid boundary
-  // mesh (segment-facet intersection)" for some sizes on thin layers).
+  // gmsh 4.8 throws std::string from inside its 3-D mesher for some sizes on thin
+  // layers (e.g. "Could not recover boundary mesh: error 2" for the physical laminate
+  // with foot pads at 7.5 mm).
   auto refuse = [&](const std::string& what) {
     std::ostringstream size;
     size << mesh_size;
