@@ -179,8 +179,8 @@ Scene scene_from_yaml(const YAML::Node& root, const std::string& path) {
   Reader r{path, &scene};
   if (!root.IsMap()) throw InputError(path, "a scene must be a mapping with keys geometry/mesh, materials, ...");
   r.allow(root, "",
-          {"name", "geometry", "mesh", "materials", "boundary", "loads", "solver", "output", "dynamics", "contact",
-           "actuation", "environment"});
+          {"name", "geometry", "mesh", "materials", "membranes", "boundary", "loads", "solver", "output", "dynamics",
+           "contact", "actuation", "environment"});
   scene.source = path;
   if (root["name"]) scene.name = r.text(root["name"], "name");
 
@@ -253,6 +253,24 @@ Scene scene_from_yaml(const YAML::Node& root, const std::string& path) {
     ParamSet p = r.params(kv.second, "materials." + region);
     if (!p.has("model")) r.fail(kv.second, "materials." + region, "missing key 'model'");
     scene.materials[region] = p;
+  }
+
+  if (const auto membranes = root["membranes"]) {  // surface region -> sheet (fem/membrane.h)
+    if (!membranes.IsMap())
+      r.fail(membranes, "membranes", "expected a mapping: surface region -> {model, thickness, ...}");
+    for (const auto& kv : membranes) {
+      const std::string surface = kv.first.as<std::string>();
+      const std::string key = "membranes." + surface;
+      ParamSet p = r.params(kv.second, key);
+      if (!p.has("model")) r.fail(kv.second, key, "missing key 'model'");
+      if (!p.has("thickness")) r.fail(kv.second, key, "missing key 'thickness' [m]");
+      MembraneSpec spec;
+      spec.surface = surface;
+      spec.thickness = p.number_in("thickness", 1e-9, 1.0);
+      spec.law = make_membrane_law(p.without("thickness"));
+      spec.where = p.where("model");
+      scene.membranes.push_back(spec);
+    }
   }
 
   if (const auto b = root["boundary"]) {

@@ -8,6 +8,9 @@
 //   mesh: {file: body.msh}                      # instead of geometry
 //   materials:                                  # volume region -> law (fem/material.h)
 //     body: {model: neo_hookean, mu: 80e3, kappa: 80e6, density: 1070}
+//   membranes:                                  # surface region -> thin sheet (fem/membrane.h)
+//     fabric_sheet: {model: fabric, thickness: 5e-4, mu: 1e6, fibre_modulus: 2.6e8,
+//                    fibres: [1, 0, 0, 0, 1, 0]}   # no mass: fold it into the volume's density
 //   boundary:                                   # surface region -> prescribed displacement
 //     - {surface: sym_x, fix: [x]}              # u_x = 0
 //     - {surface: top, displacement: [0, 0, -1e-3]}   # ramped linearly over the run
@@ -89,6 +92,7 @@
 #include "contact/self_contact.h"
 #include "core/params.h"
 #include "fem/inertia.h"
+#include "fem/membrane.h"
 #include "fem/pull_spring.h"
 #include "fem/solver.h"
 
@@ -125,6 +129,7 @@ struct Scene {
   ParamSet geometry;                          // builder parameters (type, sizes, mesh_size, order)
   std::string mesh_file;                      // or a .msh file
   std::map<std::string, ParamSet> materials;  // volume region -> law parameters
+  std::vector<MembraneSpec> membranes;        // sheets on surface regions
   std::vector<BoundarySpec> boundary;
   Eigen::Vector3d gravity = Eigen::Vector3d::Zero();
   std::vector<CavitySpec> cavities;

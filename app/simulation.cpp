@@ -121,6 +121,7 @@ Mesh build_scene_mesh(const Scene& scene, MPI_Comm comm) {
     if (!scene.materials.count(name))
       throw InputError(src + ": materials", "no material for volume region '" + name + "'");
   for (const auto& b : scene.boundary) require_surface(scene, mesh, b.surface, b.where, "boundary");
+  for (const auto& m : scene.membranes) require_surface(scene, mesh, m.surface, m.where, "membranes");
   for (const auto& c : scene.cavities)
     for (const auto& s : c.surfaces) require_surface(scene, mesh, s, "", "loads.cavities." + c.name);
   for (const auto& t : scene.tractions) require_surface(scene, mesh, t.surface, t.where, "loads.tractions");
@@ -176,6 +177,8 @@ SimulationResult run_scene(const Scene& scene, MPI_Comm comm, const RunOptions& 
     }
   }
   assembler.add_term(elastic);
+  for (const auto& spec : scene.membranes)
+    assembler.add_term(std::make_shared<MembraneTerm>(mesh, partition, rank, spec));
   if (scene.gravity.norm() > 0) {
     // Gravity is a body force rho g [N/m^3]; rho depends on the cell's region, so
     // one term per region keeps the kernel a pure function of X.

@@ -278,6 +278,15 @@ void check_msh_header(const std::string& path) {
 
 }  // namespace
 
+namespace {
+void start_gmsh() {
+  gmsh::initialize(0, nullptr, false);
+  gmsh::option::setNumber("General.Terminal", 0);
+  gmsh::option::setNumber("General.Verbosity", 2);
+  gmsh::option::setNumber("General.NumThreads", 1);
+}
+}  // namespace
+
 ScopedGmshModel::ScopedGmshModel(const std::string& name) {
   initialize_gmsh();
   gmsh::model::add(name);
@@ -305,23 +314,28 @@ void generate_tet_mesh(double mesh_size, int order, const std::string& where) {
     throw InputError(where, "gmsh could not mesh the geometry at mesh_size " + size.str() + " m (gmsh: " + what +
                                 "); a slightly different mesh_size usually meshes");
   };
+  // A mesher that threw leaves gmsh's global state broken (the next model in the same
+  // process then comes out with unmeshed surfaces): restart gmsh before reporting, with
+  // an empty current model for the caller's ScopedGmshModel to remove.
+  auto restart = [] {
+    gmsh::finalize();
+    start_gmsh();
+    gmsh::model::add("morphfem_after_mesher_failure");
+  };
   try {
     gmsh::model::mesh::generate(3);
   } catch (const std::string& e) {
+    restart();
     refuse(e);
   } catch (const std::exception& e) {
+    restart();
     refuse(e.what());
   }
 }
 
 void initialize_gmsh() {
   static std::once_flag once;
-  std::call_once(once, [] {
-    gmsh::initialize(0, nullptr, false);
-    gmsh::option::setNumber("General.Terminal", 0);
-    gmsh::option::setNumber("General.Verbosity", 2);
-    gmsh::option::setNumber("General.NumThreads", 1);
-  });
+  std::call_once(once, start_gmsh);
 }
 
 Mesh mesh_from_current_gmsh_model(const std::string& source) {

@@ -55,6 +55,7 @@ struct Assembly {
   double foot_length = 0.0;               // feet: y in [0, foot_length] and [length - foot_length, length]
   double foot_z = 0.0;                    // z of the skin's bottom face (the feet plane)
   double scale = 0.0;                     // largest body dimension (for tolerances)
+  std::vector<double> sheet_z;            // z of internal planes named fabric_sheet (membranes)
 };
 
 // Representative point (centroid of the first triangle) and node box of a meshed surface.
@@ -136,6 +137,13 @@ Mesh mesh_assembly(const Assembly& assembly, double mesh_size, int order, const 
   for (const auto& [dim, tag] : surfaces) {
     std::vector<int> up, down;
     gmsh::model::getAdjacencies(dim, tag, up, down);
+    if (up.size() == 2 && !assembly.sheet_z.empty()) {  // an interface: a fabric sheet's plane?
+      const SurfaceSample s = sample_surface(tag);
+      const bool sheet = s.axis == 2 && std::any_of(assembly.sheet_z.begin(), assembly.sheet_z.end(), [&](double z) {
+                           return std::abs(s.nodes.lo.z() - z) <= tol && std::abs(s.nodes.hi.z() - z) <= tol;
+                         });
+      if (sheet) surface_tags["fabric_sheet"].push_back(tag);
+    }
     if (up.size() != 1) continue;
     const SurfaceSample s = sample_surface(tag);
     auto cavity = std::find_if(assembly.cavities.begin(), assembly.cavities.end(),
@@ -174,6 +182,7 @@ Mesh mesh_assembly(const Assembly& assembly, double mesh_size, int order, const 
   for (const Cavity& c : assembly.cavities) surface_order.push_back(c.surface);
   for (const char* name : {"bottom", "foot_a", "foot_b", "outer", "skin_surface", "bladder_surface", "end_a", "end_b"})
     if (assembly.foot_length > 0 || std::string(name).rfind("foot_", 0) != 0) surface_order.push_back(name);  // no feet
+  if (!assembly.sheet_z.empty()) surface_order.push_back("fabric_sheet");
   for (const std::string& name : surface_order) add_group(2, surface_tags[name], name);
 
   return mesh_from_current_gmsh_model(source);
@@ -292,13 +301,19 @@ Mesh build_robot_voxel(const ParamSet& params) {
 Mesh build_robot_physical(const ParamSet& params) {
   params.allow_only({"type", "mesh_size", "order", "width", "length", "skin_thickness", "fabric_thickness", "core_gap",
                      "edge_width", "end_seal", "bladder_thickness", "bladder_wall", "bladder_width", "foot_length",
-                     "bladder_end_walls", "foot_pad"});
+                     "bladder_end_walls", "foot_pad", "fabric"});
   const CommonRobot c = common_robot(params, 0.10, 0.15, 0.001, 0.005, 0.005, 0.003, 0.02, 0.02);
   // 0: chambers open at both ends (no end walls), e.g. for a plane-strain slice in which
   // the chambers run through the whole slice (foot_length 0) as open sleeves.
   const bool end_walls = params.integer_in("bladder_end_walls", 0, 1, 1) == 1;
   const double t = length_param(params, "skin_thickness", 0.003);
-  const double tf = length_param(params, "fabric_thickness", 0.0005);
+  // The fabric: a solid layer (volume `fabric`, fabric_thickness thick) or a sheet
+  // without thickness in the mesh (surface `fabric_sheet`, an interface inside the skin
+  // layer, for a membrane term: no thin tetrahedra).
+  const std::string fabric = params.string("fabric", "solid");
+  require(fabric == "solid" || fabric == "membrane", params, "fabric", "must be 'solid' or 'membrane'");
+  const bool sheet = fabric == "membrane";
+  const double tf = sheet ? 0.0 : length_param(params, "fabric_thickness", 0.0005);
   const double w = length_param(params, "bladder_wall", 0.0008);
   require(tf < t, params, "fabric_thickness", "the fabric must be thinner than the skin layer");
   require(2 * w < std::min(c.bladder_thickness, c.bladder_width), params, "bladder_wall",
@@ -316,7 +331,7 @@ Mesh build_robot_physical(const ParamSet& params) {
   Assembly a;
   a.length = c.length;
   a.foot_length = c.foot_length;
-  a.volume_order = volume_order(true);
+  a.volume_order = volume_order(!sheet);
   if (pad > 0) a.volume_order.push_back("foot");
   const double hb = c.bladder_thickness, ds = 0.5 * (t - tf);
   const double base = std::max(0.0, pad - hb);  // lift of the body over the ground plane z = 0
@@ -327,14 +342,16 @@ Mesh build_robot_physical(const ParamSet& params) {
     a.pieces.push_back({axis_box(0, c.width, 0, c.foot_length, a.foot_z, z_skin), "foot"});
     a.pieces.push_back({axis_box(0, c.width, c.length - c.foot_length, c.length, a.foot_z, z_skin), "foot"});
   }
-  // Each skin layer: DS10 | fabric | DS10; the lowest sheet is split at the feet.
+  // Each skin layer: DS10 | fabric | DS10 (the fabric a sheet at mid-thickness: DS10 |
+  // DS10); the lowest sheet is split at the feet.
   add_split_layer(a, c.width, z_skin, z_skin + ds, "skin");
-  a.pieces.push_back({axis_box(0, c.width, 0, c.length, z_skin + ds, z_skin + ds + tf), "fabric"});
+  if (!sheet) a.pieces.push_back({axis_box(0, c.width, 0, c.length, z_skin + ds, z_skin + ds + tf), "fabric"});
   a.pieces.push_back({axis_box(0, c.width, 0, c.length, z_skin + ds + tf, z_core), "skin"});
   add_core(a, c.width, c.edge, c.seal, z_core, z_top);
   a.pieces.push_back({axis_box(0, c.width, 0, c.length, z_top, z_top + ds), "skin"});
-  a.pieces.push_back({axis_box(0, c.width, 0, c.length, z_top + ds, z_top + ds + tf), "fabric"});
+  if (!sheet) a.pieces.push_back({axis_box(0, c.width, 0, c.length, z_top + ds, z_top + ds + tf), "fabric"});
   a.pieces.push_back({axis_box(0, c.width, 0, c.length, z_top + ds + tf, z_upper), "skin"});
+  if (sheet) a.sheet_z = {z_skin + ds, z_top + ds};
   // Bladders: closed DS30 chambers (floor, roof, two side walls, two end walls), or
   // without end walls open sleeves along y.
   const double y0 = c.foot_length, y1 = c.length - c.foot_length, we = end_walls ? w : 0.0;

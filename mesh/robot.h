@@ -43,10 +43,13 @@
 //   `foot`, standing in for the foot balloon in its lamina; its bottom face is the foot.
 //   A pad thicker than bladder_thickness lifts the body: the robot stands on its feet
 //   with the pads' bottoms at z = 0, as in a pull test).
+//   fabric: solid (default: the volume `fabric`) or membrane (no fabric volume: each skin
+//   layer is DS10 throughout, split at its mid-thickness by an internal surface
+//   `fabric_sheet` for a membrane term, fem/membrane.h; fabric_thickness is then unused).
 //   Volumes: skin (DS10: both layers without the fabric, the bonding strips), fabric,
 //   bladder_1 .. bladder_8 (DS30 chamber walls), foot (with foot_pad > 0).
 //   Surfaces: core_wall, bladder_1_wall .. bladder_8_wall (closed chamber cavities),
-//   bottom, foot_a, foot_b, outer (as for robot_voxel).
+//   bottom, foot_a, foot_b, outer (as for robot_voxel), fabric_sheet (membrane fabric).
 #pragma once
 #include "core/params.h"
 #include "mesh/mesh.h"

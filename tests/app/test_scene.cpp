@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 #include <petscsys.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 
@@ -127,6 +128,51 @@ TEST(Scene, GravityWithoutDensityIsRejected) {
   text = replace(text, "solver:", "loads: {gravity: [0, 0, -9.81]}\nsolver:");
   std::string e = error_of(text);
   EXPECT_NE(e.find("density"), std::string::npos) << e;
+}
+
+// A stiff incompressible neo-Hookean sheet (mu t = 100 N/m) on top of a block 2500x
+// softer (mu h = 0.04 N/m), pulled to lambda = 1.5 along x and free across: the sheet
+// contracts to the plane-stress closed form lambda_2 = lambda^(-1/2) = 0.8165 (the block's
+// resistance changes it by at most O(4e-4)), and the homogeneous state is exact on P1.
+TEST(Scene, MembraneStretchesAsTheIncompressibleClosedForm) {
+  const char* kSheet = R"(name: sheet
+geometry: {type: block, lx: 0.04, ly: 0.02, lz: 0.004, mesh_size: 0.01, order: 1}
+materials:
+  body: {model: neo_hookean, mu: 10, nu: 0.3}
+membranes:
+  zmax: {model: neo_hookean, thickness: 1.0e-3, mu: 1.0e5}
+boundary:
+  - {surface: xmin, fix: [x]}
+  - {surface: xmax, displacement: [0.02, 0, 0]}
+  - {surface: ymin, fix: [y]}
+  - {surface: zmin, fix: [z]}
+solver: {end_time: 1, initial_step: 0.25}
+)";
+  TempScene s(kSheet);
+  Scene scene = read_scene(s.file.string());
+  ASSERT_EQ(scene.membranes.size(), 1u);
+  scene.boundary[1].components = {true, false, false};  // xmax: only u_x prescribed (free across)
+  const auto r = run_scene(scene, PETSC_COMM_WORLD, {false, false, {}});
+  ASSERT_TRUE(r.stats.completed);
+  double y_max = 0;
+  for (int n : r.mesh.nodes_of_surface("zmax")) y_max = std::max(y_max, r.mesh.X(n, 1) + r.u(n, 1));
+  EXPECT_NEAR(y_max / 0.02, 1.0 / std::sqrt(1.5), 2e-4);  // measured 2.7e-5
+  // Without the sheet the soft block (nu 0.3) contracts much less: the sheet decides.
+  scene.membranes.clear();
+  const auto bare = run_scene(scene, PETSC_COMM_WORLD, {false, false, {}});
+  double y_bare = 0;
+  for (int n : bare.mesh.nodes_of_surface("zmax")) y_bare = std::max(y_bare, bare.mesh.X(n, 1) + bare.u(n, 1));
+  EXPECT_GT(y_bare / 0.02, 0.85);
+}
+
+TEST(Scene, MembraneOnAnUnknownSurfaceOrWithoutThicknessIsRejected) {
+  const std::string sheet = "membranes:\n  top: {model: neo_hookean, thickness: 1.0e-3, mu: 1.0e5}\nboundary:";
+  std::string e = error_of(replace(kGood, "boundary:", sheet));
+  EXPECT_NE(e.find("top"), std::string::npos) << e;
+  EXPECT_NE(e.find("zmax"), std::string::npos) << e;  // the known surfaces
+  e = error_of(replace(kGood, "boundary:", "membranes:\n  zmax: {model: neo_hookean, mu: 1.0e5}\nboundary:"));
+  EXPECT_NE(e.find("thickness"), std::string::npos) << e;
+  EXPECT_NE(e.find("scene.yaml:6:"), std::string::npos) << e;
 }
 
 TEST(Scene, MissingFileIsAnInputError) { EXPECT_THROW(read_scene("/nonexistent/scene.yaml"), InputError); }
