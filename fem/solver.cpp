@@ -262,9 +262,19 @@ PetscErrorCode QuasiStaticSolver::line_search(SNESLineSearch ls) {
   }
   // -morphfem_linesearch_monitor: the admissible step, the term that bounds it, and
   // the accepted step (diagnosing stagnating Newton iterations).
-  if (linesearch_monitor_)
+  if (linesearch_monitor_) {
     PetscCall(PetscPrintf(assembler_.comm(), "      line search: max step %.3e (%s), %s %.3e, slope %.3e\n", lambda_max,
                           limiter.c_str(), accepted ? "accepted" : "rejected down to", lambda, slope));
+    if (lambda < lambda_max) {  // backtracked: which terms' energies rose over the largest step
+      const std::vector<double> before = assembler_.term_energies(X);
+      PetscCall(VecWAXPY(W, -lambda_max, Y, X));
+      const std::vector<double> after = assembler_.term_energies(W);
+      for (size_t k = 0; k < before.size(); ++k)
+        PetscCall(PetscPrintf(assembler_.comm(), "        %-24s dE %+.3e at the max step\n",
+                              assembler_.terms()[k]->name().c_str(), after[k] - before[k]));
+      PetscCall(VecWAXPY(W, -lambda, Y, X));  // the accepted state, as before
+    }
+  }
   if (!accepted) {
     PetscCall(SNESLineSearchSetReason(ls, SNES_LINESEARCH_FAILED_REDUCT));
     return 0;
