@@ -19,6 +19,14 @@
 
 namespace morphfem {
 
+double relative_error(double value, double reference) { return std::abs(value - reference) / std::abs(reference); }
+
+void VerificationRecord::compare(double measured, double exact) {
+  value = measured;
+  reference = exact;
+  rel_error = relative_error(measured, exact);
+}
+
 std::string VerificationRecord::json() const {
   Json j;
   j.add("case", case_name)
@@ -313,14 +321,10 @@ void cylinder_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<Verifica
     }
     const double la = sum / vertices.size() / A;
     auto rec = verification_record("cylinder", "P/mu at computed inner stretch" + suffix, int(level), order, h, r);
-    rec.value = p_over_mu;
-    rec.reference = cylinder_pressure(la, A / B);
-    rec.rel_error = std::abs(rec.value - rec.reference) / rec.reference;
+    rec.compare(p_over_mu, cylinder_pressure(la, A / B));
     out.push_back(rec);
     auto srec = verification_record("cylinder", "inner stretch (reference 2.0)" + suffix, int(level), order, h, r);
-    srec.value = la;
-    srec.reference = 2.0;
-    srec.rel_error = std::abs(la - 2.0) / 2.0;
+    srec.compare(la, 2.0);
     out.push_back(srec);
   }
 }
@@ -373,9 +377,7 @@ void cantilever_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<Verifi
       for (const auto& [k, v] : deflection) {
         auto rec =
             verification_record("cantilever", "tip deflection v/L, k=" + std::to_string(k), int(level), order, size, r);
-        rec.value = v;
-        rec.reference = reference.at(k);
-        rec.rel_error = std::abs(v - rec.reference) / rec.reference;
+        rec.compare(v, reference.at(k));
         out.push_back(rec);
       }
     }
@@ -427,9 +429,7 @@ void slope_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<Verificatio
     slide /= r.mesh.n_nodes();
     auto rec = verification_record("slope", "slide s(2.5 s) [m], dt=" + std::to_string(dt).substr(0, 6), int(level), 1,
                                    L / 2, r);
-    rec.value = slide;
-    rec.reference = reference;
-    rec.rel_error = std::abs(slide - reference) / reference;
+    rec.compare(slide, reference);
     rec.rate = rate.next(rec.rel_error, dt);
     out.push_back(rec);
   }
@@ -461,9 +461,7 @@ void friction_switch_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<V
     const double slide = r.u.col(0).mean();
     auto rec = verification_record("friction_switch", "slide [m] over 3 s, dt=" + std::to_string(dt).substr(0, 5),
                                    int(level), 1, L / 2, r);
-    rec.value = slide;
-    rec.reference = reference;
-    rec.rel_error = std::abs(slide - reference) / reference;
+    rec.compare(slide, reference);
     rec.rate = rate.next(rec.rel_error, dt);
     out.push_back(rec);
     auto still = verification_record("friction_switch", "creep [m] while mu = 0.9 (t < 1 s)", int(level), 1, L / 2, r);

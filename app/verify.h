@@ -19,7 +19,12 @@ struct VerificationRecord {
   double wall_s = 0;
   int newton_its = 0, steps = 0, step_cuts = 0;
   std::string json() const;
+  // Sets value, reference and rel_error = |value - reference| / |reference| (reference != 0).
+  void compare(double measured, double exact);
 };
+
+// |value - reference| / |reference| [-].
+double relative_error(double value, double reference);
 
 struct VerifyOptions {
   std::vector<std::string> cases;  // empty: every core case (or every hard case with `hard`)

@@ -23,8 +23,6 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-double rel_error(double value, double reference) { return std::abs(value - reference) / std::abs(reference); }
-
 // "0.001" rather than "0.001000": a number for record labels.
 std::string short_number(double v) {
   char buffer[32];
@@ -277,9 +275,7 @@ void rolling_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<Verificat
     const std::string quantity =
         (slip ? "slip a [m/s^2], mu=" + short_number(run.mu) : std::string("rolling a [m/s^2]")) + detail;
     auto rec = verification_record("rolling", quantity, level, 2, run.mesh_size, r.run);
-    rec.value = r.acceleration;
-    rec.reference = reference;
-    rec.rel_error = rel_error(r.acceleration, reference);
+    rec.compare(r.acceleration, reference);
     return rec;
   };
   for (const Ladder& ladder : ladders)
@@ -291,7 +287,7 @@ void rolling_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<Verificat
       if (level > 0) {
         const Run& prev = ladder.rungs[level - 1];
         const Run& run = ladder.rungs[level];
-        rec.rate = observed_rate(rel_error(result_of(prev).acceleration, rec.reference),
+        rec.rate = observed_rate(relative_error(result_of(prev).acceleration, rec.reference),
                                  ladder.over_dt ? prev.dt : prev.mesh_size, rec.rel_error,
                                  ladder.over_dt ? run.dt : run.mesh_size);
       }
@@ -303,9 +299,7 @@ void rolling_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<Verificat
   out.push_back(record(inclined, ", inclined plane, dt=0.001", 0));
   auto diff = verification_record("rolling", "inclined plane vs tilted gravity a, dt=0.001", 0, 2, R / 4,
                                   result_of(inclined).run);
-  diff.value = result_of(inclined).acceleration;
-  diff.reference = result_of(tilted).acceleration;
-  diff.rel_error = rel_error(diff.value, diff.reference);
+  diff.compare(result_of(inclined).acceleration, result_of(tilted).acceleration);
   out.push_back(diff);
   // A thick-walled tube, inner radius r = 0.8 R: I = m (R^2 + r^2) / 2, rolling
   // a = g sin / (1 + (1 + r^2/R^2) / 2) (-> g sin / 2 for a thin wall); needs
@@ -316,9 +310,7 @@ void rolling_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<Verificat
   const RollingResult r = run_rolling(tube, opt, comm);
   const double k = 0.5 * (1 + 0.64);
   auto rec = verification_record("rolling", "tube r=0.8R rolling a [m/s^2], dt=0.001", 0, 2, tube.mesh_size, r.run);
-  rec.value = r.acceleration;
-  rec.reference = kGravity * std::sin(kSlope) / (1 + k);
-  rec.rel_error = rel_error(rec.value, rec.reference);
+  rec.compare(r.acceleration, kGravity * std::sin(kSlope) / (1 + k));
   out.push_back(rec);
 }
 
@@ -338,16 +330,12 @@ void hertz_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<Verificatio
     const HertzResult r = run_hertz(setup, opt, comm);
     auto F = verification_record("hertz", "contact force F [N], d/R=0.01, dhat=" + short_number(setup.dhat), int(level),
                                  2, setup.contact_size, r.run);
-    F.value = r.force;
-    F.reference = F_ref;
-    F.rel_error = rel_error(r.force, F_ref);
+    F.compare(r.force, F_ref);
     F.rate = level > 0 ? observed_rate(prev_F, prev_h, F.rel_error, setup.contact_size) : 0.0;
     out.push_back(F);
     auto a = verification_record("hertz", "contact radius a [m], sqrt(5/2 <r^2>_F)", int(level), 2, setup.contact_size,
                                  r.run);
-    a.value = r.contact_radius;
-    a.reference = a_ref;
-    a.rel_error = rel_error(r.contact_radius, a_ref);
+    a.compare(r.contact_radius, a_ref);
     a.rate = level > 0 ? observed_rate(prev_a, prev_h, a.rel_error, setup.contact_size) : 0.0;
     out.push_back(a);
     prev_F = F.rel_error;
@@ -362,9 +350,7 @@ void hertz_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<Verificatio
     const HertzResult r = run_hertz(setup, opt, comm);
     auto F = verification_record("hertz", "contact force F [N], d/R=0.01, dhat=" + short_number(dhat),
                                  int(sizes.size()), 2, setup.contact_size, r.run);
-    F.value = r.force;
-    F.reference = F_ref;
-    F.rel_error = rel_error(r.force, F_ref);
+    F.compare(r.force, F_ref);
     out.push_back(F);
   }
   // The remaining difference from Hertz is the model's (finite sphere, finite strain),
@@ -376,9 +362,7 @@ void hertz_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<Verificatio
   const HertzResult r = run_hertz(shallow, opt, comm);
   auto F = verification_record("hertz", "contact force F [N], d/R=0.0025, dhat=" + short_number(shallow.dhat),
                                int(sizes.size()) + 1, 2, shallow.contact_size, r.run);
-  F.value = r.force;
-  F.reference = F_ref / 8;  // F ~ d^(3/2)
-  F.rel_error = rel_error(r.force, F.reference);
+  F.compare(r.force, F_ref / 8);  // F ~ d^(3/2)
   out.push_back(F);
 }
 
