@@ -33,13 +33,14 @@ std::string source_dir() { return MORPHFEM_SOURCE_DIR; }
 const char* kRobotUsage =
     "usage: morphfem robot COMMAND [options]\n"
     "  validate [--fidelity L] [--cases A,B,...] [--presets voxel,physical] [--out DIR]\n"
-    "           [--set KEY=VALUE ...] [--set-physical KEY=VALUE ...]\n"
+    "           [--set KEY=VALUE ...] [--set-physical KEY=VALUE ...] [--set-physical-round KEY=VALUE ...]\n"
+    "           [--set-physical-flat KEY=VALUE ...]\n"
     "        the voxel study's baselines (hand-designed rolling and inching, flat and\n"
     "        15 deg hill, four empty schedules): voxel speed beside the finite-element\n"
     "        speed (voxel-study preset, growth actuation; --set keys, level L), wall time,\n"
     "        dofs, steps, and beside the physical laminate with pressure actuation (inflated:\n"
     "        examples/physical/roll_slice.yaml, flat: examples/physical/inch_flat.yaml;\n"
-    "        --set-physical keys apply to both)\n"
+    "        --set-physical keys apply to both, --set-physical-round / -flat to one)\n"
     "  ladder --case NAME [--levels 0,1,2] [--out DIR]\n"
     "        one case on several fidelity levels: speed against wall time, and the\n"
     "        cheapest level within 5 % of the finest\n"
@@ -397,7 +398,8 @@ Json outcome_json(const RobotCase& c, const RobotFidelity& level, const CaseOutc
 }
 
 int validate(const std::vector<std::string>& args, MPI_Comm comm) {
-  check_options(args, {"--fidelity", "--cases", "--out", "--set", "--set-physical", "--presets"});
+  check_options(args, {"--fidelity", "--cases", "--out", "--set", "--set-physical", "--set-physical-round",
+                       "--set-physical-flat", "--presets"});
   const RobotFidelity& level = find_robot_fidelity(option(args, "--fidelity", "0"));
   const std::string out_dir = option(args, "--out", "results/robot/validate");
   bool voxel = false, physical = false;
@@ -409,7 +411,11 @@ int validate(const std::vector<std::string>& args, MPI_Comm comm) {
   auto all_cases = voxel_baseline_cases(source_dir());
   for (auto& c : all_cases) c.overrides = options(args, "--set");
   auto physical_cases = physical_baseline_cases(source_dir());
-  for (auto& c : physical_cases) c.overrides = options(args, "--set-physical");
+  for (auto& c : physical_cases) {  // both templates, then the inflated (round) or the flat one
+    c.overrides = options(args, "--set-physical");
+    const auto own = options(args, c.schedule.core_pressure_pa > 0 ? "--set-physical-round" : "--set-physical-flat");
+    c.overrides.insert(c.overrides.end(), own.begin(), own.end());
+  }
   std::vector<std::string> names;
   const std::string wanted = option(args, "--cases", "");
   for (const auto& c : all_cases) names.push_back(c.name);
@@ -474,8 +480,9 @@ int validate(const std::vector<std::string>& args, MPI_Comm comm) {
   std::string overrides;  // the --set assignments, as given
   for (const auto& assignment : options(args, "--set")) overrides += (overrides.empty() ? "" : "; ") + assignment;
   std::string physical_overrides;
-  for (const auto& assignment : options(args, "--set-physical"))
-    physical_overrides += (physical_overrides.empty() ? "" : "; ") + assignment;
+  for (const char* flag : {"--set-physical", "--set-physical-round", "--set-physical-flat"})
+    for (const auto& assignment : options(args, flag))
+      physical_overrides += (physical_overrides.empty() ? "" : "; ") + std::string(flag + 2) + " " + assignment;
   summary.add("fidelity", level.name)
       .add("overrides", overrides)
       .add("physical_overrides", physical_overrides)
