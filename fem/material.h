@@ -15,6 +15,7 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "core/params.h"
 
@@ -75,5 +76,9 @@ std::unique_ptr<Material> make_fabric(const ParamSet& params);
 double bulk_modulus_from_params(const ParamSet& params, double mu0);
 // `key` must be a number in (0, hi]; the message says what the parameter is.
 double positive_parameter(const ParamSet& params, const std::string& key, double hi, const std::string& what);
+// Fibre families of a fabric: `fibres` as 3 numbers per family (default the warp along
+// x and the weft along y), each normalised; a zero direction or a list whose length is
+// not a multiple of 3 throws InputError at the key.
+std::vector<Eigen::Vector3d> fibre_directions(const ParamSet& params);
 
 }  // namespace morphfem

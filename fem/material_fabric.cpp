@@ -75,9 +75,7 @@ class Fabric final : public Material {
 
 }  // namespace
 
-std::unique_ptr<Material> make_fabric(const ParamSet& params) {
-  params.allow_only({"model", "mu", "kappa", "nu", "fibre_modulus", "fibres"});
-  const double modulus = positive_parameter(params, "fibre_modulus", 1e13, "fibre modulus E_f [Pa]");
+std::vector<Eigen::Vector3d> fibre_directions(const ParamSet& params) {
   const std::vector<double> list = params.list("fibres", {1, 0, 0, 0, 1, 0});
   if (list.empty() || list.size() % 3 != 0)
     throw InputError(params.where("fibres"), "fibres: expected 3 numbers per fibre family (x, y, z of its direction)");
@@ -89,8 +87,14 @@ std::unique_ptr<Material> make_fabric(const ParamSet& params) {
                        "fibres: family " + std::to_string(k / 3 + 1) + " has no direction (a zero vector)");
     fibres.push_back(a.normalized());
   }
+  return fibres;
+}
+
+std::unique_ptr<Material> make_fabric(const ParamSet& params) {
+  params.allow_only({"model", "mu", "kappa", "nu", "fibre_modulus", "fibres"});
+  const double modulus = positive_parameter(params, "fibre_modulus", 1e13, "fibre modulus E_f [Pa]");
   return std::make_unique<Fabric>(make_neo_hookean(params.without("fibre_modulus").without("fibres")), modulus,
-                                  std::move(fibres));
+                                  fibre_directions(params));
 }
 
 }  // namespace morphfem

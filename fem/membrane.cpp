@@ -78,18 +78,7 @@ std::unique_ptr<MembraneLaw> make_fabric_membrane(const ParamSet& params) {
   params.allow_only({"model", "mu", "fibre_modulus", "fibres"});
   const double mu = positive_parameter(params, "mu", 1e13, "matrix shear modulus [Pa]");
   const double modulus = positive_parameter(params, "fibre_modulus", 1e13, "fibre modulus E_f [Pa]");
-  const std::vector<double> list = params.list("fibres", {1, 0, 0, 0, 1, 0});
-  if (list.empty() || list.size() % 3 != 0)
-    throw InputError(params.where("fibres"), "fibres: expected 3 numbers per fibre family (x, y, z of its direction)");
-  std::vector<Eigen::Vector3d> fibres;
-  for (size_t k = 0; k < list.size(); k += 3) {
-    const Eigen::Vector3d a(list[k], list[k + 1], list[k + 2]);
-    if (!(a.norm() > 1e-12) || !a.allFinite())
-      throw InputError(params.where("fibres"),
-                       "fibres: family " + std::to_string(k / 3 + 1) + " has no direction (a zero vector)");
-    fibres.push_back(a.normalized());
-  }
-  return std::make_unique<FabricMembrane>("fabric", mu, modulus, std::move(fibres));
+  return std::make_unique<FabricMembrane>("fabric", mu, modulus, fibre_directions(params));
 }
 
 }  // namespace

@@ -11,30 +11,16 @@
 #include "contact/friction.h"
 #include "contact/ground.h"
 #include "core/errors.h"
-#include "mesh/geometry.h"
+#include "tests/support/block_mesh.h"
 
 using namespace morphfem;
 
 namespace {
 
 Mesh block(int order, double mesh_size = 0.05) {
-  ParamSet p("test block");
-  p.set_string("type", "block");
-  p.set("lx", 0.1);
-  p.set("ly", 0.08);
-  p.set("lz", 0.06);
-  p.set("mesh_size", mesh_size);
-  p.set("order", order);
-  return build_geometry(p);
+  return morphfem::testing::block_mesh({0.1, 0.08, 0.06}, mesh_size, order);
 }
-
-Partition single_part(const Mesh& mesh) {
-  Partition part;
-  part.n_parts = 1;
-  part.cell_part.assign(mesh.n_cells(), 0);
-  part.node_begin = {0, mesh.n_nodes()};
-  return part;
-}
+using morphfem::testing::one_rank;
 
 // Central-difference check of a one-node piece's gradient and Hessian at s.
 void check_piece_fd(const EnergyTerm& term, int k, const PieceState& s, double h, const std::string& what) {
@@ -97,7 +83,7 @@ TEST(GroundContact, GradientAndHessianMatchFiniteDifferences) {
   for (int order : {1, 2})
     for (int inclined : {0, 1}) {
       const Mesh mesh = block(order);
-      const Partition part = single_part(mesh);
+      const Partition part = one_rank(mesh);
       GroundContactSpec spec;
       spec.surfaces = {"zmin", "xmin"};
       spec.normal = inclined ? Eigen::Vector3d(-0.3, 0.2, 1.0) : Eigen::Vector3d(0, 0, 1);
@@ -127,7 +113,7 @@ TEST(GroundContact, GradientAndHessianMatchFiniteDifferences) {
 
 TEST(GroundContact, EnergyIsInfiniteAtOrBelowThePlaneAndZeroBeyondDhat) {
   const Mesh mesh = block(1);
-  const Partition part = single_part(mesh);
+  const Partition part = one_rank(mesh);
   GroundContactSpec spec;
   spec.surfaces = {"zmin"};
   spec.point = Eigen::Vector3d(0, 0, -1e-4);
@@ -152,7 +138,7 @@ TEST(GroundContact, EnergyIsInfiniteAtOrBelowThePlaneAndZeroBeyondDhat) {
 
 TEST(GroundContact, RejectsNodesStartingBelowThePlaneAndUnknownSurfaces) {
   const Mesh mesh = block(1);
-  const Partition part = single_part(mesh);
+  const Partition part = one_rank(mesh);
   GroundContactSpec spec;
   spec.surfaces = {"zmin"};
   spec.kappa = 1e6;
@@ -199,7 +185,7 @@ TEST_P(FrictionFD, GradientAndHessianMatchFiniteDifferences) {
   const int order = std::get<0>(GetParam());
   const double mu_k = std::get<1>(GetParam());
   const Mesh mesh = block(order);
-  const Partition part = single_part(mesh);
+  const Partition part = one_rank(mesh);
   std::mt19937 rng(7 + order);
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
   for (int inclined : {0, 1}) {
@@ -255,7 +241,7 @@ INSTANTIATE_TEST_SUITE_P(OrdersAndKinetic, FrictionFD,
 
 TEST(Friction, ProjectedHessianIsPositiveSemidefinite) {
   const Mesh mesh = block(1);
-  const Partition part = single_part(mesh);
+  const Partition part = one_rank(mesh);
   GroundContactSpec gs;
   gs.surfaces = {"zmin"};
   gs.point = Eigen::Vector3d(0, 0, -1e-4);
@@ -286,7 +272,7 @@ TEST(Friction, ProjectedHessianIsPositiveSemidefinite) {
 // area-weighted mean.
 TEST(Friction, CoefficientsPerRegionFollowTheirScheduleOverTime) {
   const Mesh mesh = block(1);
-  const Partition part = single_part(mesh);
+  const Partition part = one_rank(mesh);
   GroundContactSpec gs;
   gs.surfaces = {"zmin", "xmin"};
   gs.normal = Eigen::Vector3d(1, 0, 1);
@@ -328,7 +314,7 @@ TEST(Friction, CoefficientsPerRegionFollowTheirScheduleOverTime) {
 
 TEST(Friction, RejectsFrictionSurfacesThatAreNotContactSurfaces) {
   const Mesh mesh = block(1);
-  const Partition part = single_part(mesh);
+  const Partition part = one_rank(mesh);
   GroundContactSpec gs;
   gs.surfaces = {"zmin"};
   gs.point = Eigen::Vector3d(0, 0, -1e-4);

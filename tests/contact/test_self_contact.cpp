@@ -11,6 +11,7 @@
 #include "contact/barrier.h"
 #include "contact/self_contact.h"
 #include "mesh/geometry.h"
+#include "tests/support/block_mesh.h"
 
 using namespace morphfem;
 
@@ -95,22 +96,8 @@ namespace {
 
 // A 40 x 40 x 4 mm plate (mesh_size 20 mm) on one rank, and a spec whose barrier
 // (dhat 1 mm) is off across the plate but whose candidates (20 dhat + r) reach it.
-Mesh thin_plate(int order) {
-  ParamSet p("plate");
-  p.set_string("type", "block");
-  p.set("lx", 0.04);
-  p.set("ly", 0.04);
-  p.set("lz", 0.004);
-  p.set("mesh_size", 0.02);
-  p.set("order", order);
-  return build_geometry(p);
-}
-Partition one_rank(const Mesh& mesh) {
-  Partition part;
-  part.cell_part.assign(mesh.n_cells(), 0);
-  part.node_begin = {0, mesh.n_nodes()};
-  return part;
-}
+Mesh thin_plate(int order) { return morphfem::testing::block_mesh({0.04, 0.04, 0.004}, 0.02, order); }
+using morphfem::testing::one_rank;
 SelfContactSpec across_the_plate() {
   SelfContactSpec spec;
   spec.pairs = {{"zmin", "zmax"}};
@@ -346,9 +333,7 @@ TEST(SelfContactTerm, StartsAtItsStartTime) {
 TEST(SelfContactTerm, EdgePairsStopCrossingEdgesThatNoVertexSees) {
   const double gap = 2e-4;
   const Mesh mesh = crossing_wedges(gap / 1e-2);
-  Partition part;
-  part.cell_part.assign(mesh.n_cells(), 0);
-  part.node_begin = {0, mesh.n_nodes()};
+  const Partition part = one_rank(mesh);
   for (bool edges : {false, true}) {
     SelfContactSpec spec;
     spec.pairs = {{"a", "b"}};

@@ -9,7 +9,7 @@
 
 #include "core/errors.h"
 #include "fem/membrane.h"
-#include "mesh/geometry.h"
+#include "tests/support/block_mesh.h"
 #include "tests/support/finite_differences.h"
 
 using namespace morphfem;
@@ -28,24 +28,7 @@ std::shared_ptr<const MembraneLaw> law(const std::string& model, double fibre_mo
   return make_membrane_law(p);
 }
 
-Mesh block(int order) {
-  ParamSet p("test block");
-  p.set_string("type", "block");
-  p.set("lx", 0.1);
-  p.set("ly", 0.08);
-  p.set("lz", 0.02);
-  p.set("mesh_size", 0.04);
-  p.set("order", order);
-  return build_geometry(p);
-}
-
-Partition single_part(const Mesh& mesh) {
-  Partition part;
-  part.n_parts = 1;
-  part.cell_part.assign(mesh.n_cells(), 0);
-  part.node_begin = {0, mesh.n_nodes()};
-  return part;
-}
+Mesh block(int order) { return morphfem::testing::block_mesh({0.1, 0.08, 0.02}, 0.04, order); }
 
 // In-plane fibre directions of the (x, y) reference basis at 0 and 60 deg.
 std::vector<Eigen::Vector2d> two_fibres() { return {Eigen::Vector2d(1, 0), Eigen::Vector2d(0.5, std::sqrt(0.75))}; }
@@ -128,7 +111,7 @@ TEST(MembraneLaw, UniaxialStretchMatchesTheIncompressibleClosedForm) {
 TEST(MembraneTerm, GradientAndHessianMatchFiniteDifferences) {
   for (int order : {1, 2}) {
     const Mesh mesh = block(order);
-    const Partition part = single_part(mesh);
+    const Partition part = morphfem::testing::one_rank(mesh);
     const MembraneTerm term(mesh, part, 0, {"zmax", 5e-4, law("fabric", 5.0e6, {1, 1, 0, 0, 1, 0}), "test"});
     ASSERT_GT(term.n_pieces(), 0);
     std::mt19937 rng(3);
@@ -167,7 +150,7 @@ TEST(MembraneTerm, HomogeneousDeformationEnergyIsExact) {
   const double t = 5e-4, area = 0.1 * 0.08;
   for (int order : {1, 2}) {
     const Mesh mesh = block(order);
-    const Partition part = single_part(mesh);
+    const Partition part = morphfem::testing::one_rank(mesh);
     const MembraneTerm term(mesh, part, 0, {"zmax", t, m, "test"});
     double E = 0.0;
     std::vector<int> nodes;
@@ -185,7 +168,7 @@ TEST(MembraneTerm, HomogeneousDeformationEnergyIsExact) {
 
 TEST(MembraneTerm, RejectsBadInput) {
   const Mesh mesh = block(1);
-  const Partition part = single_part(mesh);
+  const Partition part = morphfem::testing::one_rank(mesh);
   EXPECT_THROW(MembraneTerm(mesh, part, 0, {"nowhere", 5e-4, law("neo_hookean"), "test"}), InputError);
   EXPECT_THROW(MembraneTerm(mesh, part, 0, {"zmax", 0.0, law("neo_hookean"), "test"}), InputError);
   // A fibre along the sheet's normal cannot lie in it.

@@ -8,21 +8,13 @@
 #include "core/params.h"
 #include "fem/pull_spring.h"
 #include "mesh/geometry.h"
+#include "tests/support/block_mesh.h"
 #include "tests/support/finite_differences.h"
 
 namespace morphfem {
 namespace {
 
-Mesh block_mesh(int order) {
-  ParamSet p("block");
-  p.set_string("type", "block");
-  p.set("lx", 0.02);
-  p.set("ly", 0.01);
-  p.set("lz", 0.005);
-  p.set("mesh_size", 0.005);
-  p.set("order", order);
-  return build_geometry(p);
-}
+Mesh block_mesh(int order) { return testing::block_mesh({0.02, 0.01, 0.005}, 0.005, order); }
 
 PieceState piece_state(const Mesh& mesh, const std::vector<int>& nodes, const RowMatrixXd& u) {
   PieceState s;
