@@ -22,14 +22,10 @@ class FabricMembrane final : public MembraneLaw {
   const std::vector<Eigen::Vector3d>& fibre_directions() const override { return fibres_; }
 
   double energy(const Eigen::Matrix2d& C, const std::vector<Eigen::Vector2d>& fibres) const override {
-    const double D = C.determinant();
-    if (!(D > 0)) return kInf;
-    double psi = 0.5 * mu_ * (C.trace() + 1.0 / D - 3.0);
-    if (fibre_modulus_ > 0)
-      for (const auto& a : fibres) {
-        const double e = a.dot(C * a) - 1.0;  // I4 - 1
-        if (e > 0) psi += 0.125 * fibre_modulus_ * e * e;
-      }
+    if (!(C.determinant() > 0)) return kInf;
+    double psi;
+    Eigen::Matrix2d S;
+    evaluate(C, fibres, psi, S, nullptr);
     return psi;
   }
 

@@ -4,6 +4,7 @@
 #include <petscsys.h>
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 
@@ -156,7 +157,8 @@ solver: {end_time: 1, initial_step: 0.25}
   ASSERT_TRUE(r.stats.completed);
   double y_max = 0;
   for (int n : r.mesh.nodes_of_surface("zmax")) y_max = std::max(y_max, r.mesh.X(n, 1) + r.u(n, 1));
-  EXPECT_NEAR(y_max / 0.02, 1.0 / std::sqrt(1.5), 2e-4);  // measured 2.7e-5
+  std::printf("sheet contraction %.8f, closed form %.8f\n", y_max / 0.02, 1.0 / std::sqrt(1.5));
+  EXPECT_NEAR(y_max / 0.02, 1.0 / std::sqrt(1.5), 2e-4);
   // Without the sheet the soft block (nu 0.3) contracts much less: the sheet decides.
   scene.membranes.clear();
   const auto bare = run_scene(scene, PETSC_COMM_WORLD, {false, false, {}});
