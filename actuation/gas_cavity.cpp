@@ -214,6 +214,12 @@ GasCavityTerm::GasCavityTerm(const Mesh& mesh, const Partition& partition, int r
     throw std::invalid_argument("gas cavity '" + wall_.name + "': temperature must be > 0 K");
   if (!(spec_.atmospheric_pressure >= 0))
     throw std::invalid_argument("gas cavity '" + wall_.name + "': atmospheric_pressure must be >= 0 Pa");
+  if (!std::isnan(spec_.fill_time)) {
+    if (!(spec_.fill_time > 0)) throw std::invalid_argument("gas cavity '" + wall_.name + "': fill_time must be > 0 s");
+    if (!(reference_volume_ > 0))
+      throw std::invalid_argument("gas cavity '" + wall_.name + "': fill_time needs a reference volume > 0");
+    spec_.conductance = TimeFunction::constant(time_constant(reference_volume_, 1.0) / spec_.fill_time);
+  }
   if (std::isnan(spec_.initial_amount)) {
     const double p0 = spec_.atmospheric_pressure + spec_.initial_gauge_pressure;
     if (!(p0 > 0))
@@ -299,6 +305,12 @@ VolumeControlledCavityTerm::VolumeControlledCavityTerm(const Mesh& mesh, const P
     throw std::invalid_argument("volume-controlled cavity '" + wall_.name + "': penalty_modulus must be > 0 Pa");
   if (!(spec_.tolerance > 0))
     throw std::invalid_argument("volume-controlled cavity '" + wall_.name + "': tolerance must be > 0");
+  if (spec_.volume_is_ratio) {
+    std::vector<std::pair<double, double>> points = spec_.volume.points();
+    for (auto& [t, v] : points) v *= reference_volume_;
+    spec_.volume = TimeFunction(points);
+    spec_.volume_is_ratio = false;
+  }
   base_penalty_ = penalty_ = spec_.penalty_modulus / reference_volume_;
   history_.push_back({reference_volume_, 0.0});
   set_time(0.0);

@@ -136,8 +136,12 @@ struct GasCavitySpec {
   double initial_gauge_pressure = 0.0;
   TimeFunction supply_gauge_pressure = TimeFunction::constant(0.0);  // p_s(t) [Pa]
   TimeFunction conductance = TimeFunction::constant(0.0);            // C(t) [mol/(s Pa)]
-  bool has_vacuum_conductance = false;                               // false: C(t) for vacuum too
-  TimeFunction vacuum_conductance = TimeFunction::constant(0.0);     // C_vac(t) [mol/(s Pa)]
+  // Instead of C: the fill time constant tau [s] of the rigid cavity at its
+  // reference volume, C = V_ref / (tau R T) (constant; NaN: use `conductance`).
+  // A valve sized by how fast it fills the chamber, whatever the chamber's size.
+  double fill_time = std::numeric_limits<double>::quiet_NaN();
+  bool has_vacuum_conductance = false;                            // false: C(t) for vacuum too
+  TimeFunction vacuum_conductance = TimeFunction::constant(0.0);  // C_vac(t) [mol/(s Pa)]
   // The conductance of the step ending at t1 (C or C_vac by the sign of p_s(t1)).
   double conductance_at(double t1) const {
     return has_vacuum_conductance && supply_gauge_pressure(t1) < 0 ? vacuum_conductance(t1) : conductance(t1);
@@ -204,7 +208,8 @@ class GasCavityTerm : public CavityVolumeTerm {
 // lambda = p_1 + K_s (V*(t1) - V_1), so most steps need 1-3 updates.
 struct VolumeControlSpec {
   CavityWallSpec wall;
-  TimeFunction volume;           // V*(t) [m^3], whole cavity
+  TimeFunction volume;           // V*(t) [m^3], whole cavity (or V*/V_ref, see below)
+  bool volume_is_ratio = false;  // true: `volume` is V*(t) / V_ref (the reference volume from the mesh)
   double penalty_modulus = 0.0;  // [Pa], > 0 (see above)
   double tolerance = 1e-6;       // |V - V*| <= tolerance V*
 };

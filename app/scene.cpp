@@ -295,7 +295,7 @@ Scene scene_from_yaml(const YAML::Node& root, const std::string& path) {
   }
 
   if (const auto l = root["loads"]) {
-    r.allow(l, "loads", {"gravity", "cavities", "gas_cavities", "tractions", "pulls"});
+    r.allow(l, "loads", {"gravity", "cavities", "gas_cavities", "volume_cavities", "tractions", "pulls"});
     if (l["gravity"]) scene.gravity = r.vector3(l["gravity"], "loads.gravity");
     if (const auto cs = l["cavities"]) {
       if (!cs.IsSequence()) r.fail(cs, "loads.cavities", "expected a list");
@@ -351,6 +351,35 @@ Scene scene_from_yaml(const YAML::Node& root, const std::string& path) {
           for (const auto& [t, v] : f->points())
             if (v < 0) r.fail(c[k], key + "." + k, "must not be negative");
         scene.gas_cavities.push_back(spec);
+      }
+    }
+    if (const auto vs = l["volume_cavities"]) {
+      const std::string key = "loads.volume_cavities";
+      if (!vs.IsSequence()) r.fail(vs, key, "expected a list");
+      for (const auto& c : vs) {
+        r.allow(c, key,
+                {"name", "surfaces", "volume_axes", "open_axis", "volume_ratio", "penalty_modulus", "tolerance"});
+        VolumeControlSpec spec;
+        for (const char* k : {"surfaces", "volume_ratio", "penalty_modulus"})
+          if (!c[k]) r.fail(c, key, std::string("missing key '") + k + "'");
+        spec.wall.name =
+            c["name"] ? r.text(c["name"], key + ".name") : "volume" + std::to_string(scene.volume_cavities.size());
+        spec.wall.surfaces = r.texts(c["surfaces"], key + ".surfaces");
+        if (c["volume_axes"]) spec.wall.axes = r.axes(c["volume_axes"], key + ".volume_axes");
+        r.open_axis(c, key, spec.wall.axes, spec.wall.open_axis);
+        if (!c["volume_ratio"].IsSequence())
+          r.fail(c["volume_ratio"], key + ".volume_ratio", "expected a table [[t, V/V_ref], ...]");
+        spec.volume = r.ramp_or_table(c["volume_ratio"], key + ".volume_ratio", end);
+        spec.volume_is_ratio = true;
+        for (const auto& [t, v] : spec.volume.points())
+          if (!(v > 0)) r.fail(c["volume_ratio"], key + ".volume_ratio", "volume ratios must be positive");
+        spec.penalty_modulus = r.number(c["penalty_modulus"], key + ".penalty_modulus");
+        if (!(spec.penalty_modulus > 0)) r.fail(c["penalty_modulus"], key + ".penalty_modulus", "must be positive");
+        if (c["tolerance"]) {
+          spec.tolerance = r.number(c["tolerance"], key + ".tolerance");
+          if (!(spec.tolerance > 0)) r.fail(c["tolerance"], key + ".tolerance", "must be positive");
+        }
+        scene.volume_cavities.push_back(spec);
       }
     }
     if (const auto ts = l["tractions"]) {
@@ -492,7 +521,7 @@ Scene scene_from_yaml(const YAML::Node& root, const std::string& path) {
     const std::string key = "actuation";
     r.allow(a, key,
             {"schedule", "start", "bladders", "growth", "timing", "core", "core_ramp_s", "volume_axes",
-             "core_open_axis", "bladders_open_axis", "feet", "weightless_inflated"});
+             "core_open_axis", "bladders_open_axis", "feet", "weightless_inflated", "valves"});
     if (!a["schedule"]) r.fail(a, key, "missing key 'schedule' (a schedule file)");
     if (a["schedule"].IsMap()) {  // the schedule written inline, in the schedule file format
       YAML::Emitter text;
@@ -540,20 +569,47 @@ Scene scene_from_yaml(const YAML::Node& root, const std::string& path) {
     }
     std::array<bool, 3> axes{true, true, true};
     if (a["volume_axes"]) axes = r.axes(a["volume_axes"], key + ".volume_axes");
+    // actuation.valves: every scheduled cavity holds gas fed through a valve from its
+    // regulator, whose output follows the schedule's setpoint (gas cavities,
+    // actuation/gas_cavity.h), instead of being held at the setpoint itself.
+    GasCavitySpec valve;
+    const YAML::Node valves = a["valves"];
+    if (valves) {
+      const std::string vkey = key + ".valves";
+      if (!valves.IsMap()) r.fail(valves, vkey, "expected a map {fill_time_s: T} or {conductance: C}");
+      r.allow(valves, vkey, {"fill_time_s", "conductance", "temperature"});
+      if (static_cast<bool>(valves["fill_time_s"]) == static_cast<bool>(valves["conductance"]))
+        r.fail(valves, vkey, "give exactly one of fill_time_s [s] and conductance [mol/(s Pa)]");
+      auto positive = [&](const char* k) {
+        const double v = r.calibrated_number(valves[k], vkey + "." + k);
+        if (!(v > 0)) r.fail(valves[k], vkey + "." + k, "must be positive");
+        return v;
+      };
+      if (valves["fill_time_s"]) valve.fill_time = positive("fill_time_s");
+      if (valves["conductance"]) valve.conductance = TimeFunction::constant(positive("conductance"));
+      if (valves["temperature"]) valve.temperature = positive("temperature");
+    }
     // A channel's cavity; with actuation.<open_key> an open sleeve along that axis (its
     // volume axes the other two, whatever volume_axes says).
-    auto add_cavity = [&](int channel, const std::string& surface, const char* open_key) {
+    auto add_cavity = [&](int channel, const std::string& surface, const char* open_key, TimeFunction pressure) {
       CavitySpec spec;
       spec.name = channel_name(channel);
       spec.surfaces = {surface};
       spec.axes = axes;
-      spec.pressure = channel_pressure(*schedule, channel, start);
+      spec.pressure = std::move(pressure);
       if (a[open_key]) {
         YAML::Node sleeve;
         sleeve["open_axis"] = a[open_key];
         r.open_axis(sleeve, key + "." + open_key, spec.axes, spec.open_axis);
       }
-      scene.cavities.push_back(spec);
+      if (!valves) {
+        scene.cavities.push_back(spec);
+        return;
+      }
+      GasCavitySpec gas = valve;  // starts at atmospheric pressure, the setpoint is the supply
+      gas.wall = {spec.name, spec.surfaces, spec.axes, 1.0, spec.open_axis};
+      gas.supply_gauge_pressure = spec.pressure;
+      scene.gas_cavities.push_back(gas);
     };
     if (const auto b = a["bladders"]) {
       if (!b.IsMap()) r.fail(b, key + ".bladders", "expected a map {b1: surface, ...}");
@@ -563,18 +619,20 @@ Scene scene_from_yaml(const YAML::Node& root, const std::string& path) {
         if (channel < 0 || channel >= kNumBladders)
           r.fail(kv.first, key + ".bladders." + name, "not a bladder channel (b1..b8)");
         // bladders_open_axis: chambers without end walls (a plane-strain slice)
-        add_cavity(channel, r.text(kv.second, key + ".bladders." + name), "bladders_open_axis");
+        add_cavity(channel, r.text(kv.second, key + ".bladders." + name), "bladders_open_axis",
+                   channel_pressure(*schedule, channel, start));
       }
     } else if (a["bladders_open_axis"]) {
       r.fail(a["bladders_open_axis"], key + ".bladders_open_axis", "needs 'bladders'");
     }
     if (a["core"]) {
-      add_cavity(kChannelCore, r.text(a["core"], key + ".core"), "core_open_axis");
+      TimeFunction core = channel_pressure(*schedule, kChannelCore, start);
       if (a["core_ramp_s"]) {  // the core rises linearly from 0 over [0, core_ramp_s], then holds
         const double ramp = r.number(a["core_ramp_s"], key + ".core_ramp_s");
         if (!(ramp > 0) || ramp > start) r.fail(a["core_ramp_s"], key + ".core_ramp_s", "must be in (0, start]");
-        scene.cavities.back().pressure = TimeFunction::ramp(schedule->core_pressure_pa, ramp);
+        core = TimeFunction::ramp(schedule->core_pressure_pa, ramp);
       }
+      add_cavity(kChannelCore, r.text(a["core"], key + ".core"), "core_open_axis", core);
     } else if (a["core_ramp_s"] || a["core_open_axis"]) {
       const char* k = a["core_ramp_s"] ? "core_ramp_s" : "core_open_axis";
       r.fail(a[k], key + "." + k, "needs 'core'");

@@ -31,6 +31,10 @@
 //         # supply_pressure / (vacuum_)conductance: a number (constant), a table
 //         # [[t, v], ...] or a calibrated value {calibration: FILE, parameter: NAME}
 //         # (`morphfem calibrate morphing` writes conductance_supply / _vacuum)
+//     volume_cavities:                          # a prescribed volume; the pressure is its multiplier
+//       - {name: b1, surfaces: [bladder_1_wall], volume_ratio: [[0, 1], [1, 6]],   # V*/V_ref table
+//          penalty_modulus: 1e5, tolerance: 1e-6}   # Pa (see VolumeControlSpec), |V - V*| / V*
+//         # traces a chamber's pressure-volume curve through a pressure maximum
 //     tractions:
 //       - {surface: tip, traction: [0, 0, -100]}  # dead load [Pa], ramped like pressure
 //     pulls:                                    # test machine pulling a region through a spring
@@ -66,6 +70,12 @@
 //     # (actuation/voxel_growth.h): channel -> bladder volume region, voxel timing
 //     {schedule: ..., start: 1.5, growth: {b1: bladder_1, ...}, core: core_wall,
 //      core_ramp_s: 1.0, feet: {...}, weightless_inflated: false}
+//     # valves: {fill_time_s: 0.05} (or {conductance: C} [mol/(s Pa)], temperature: 293.15):
+//     #   each scheduled cavity is a gas cavity fed through a valve whose supply is the
+//     #   regulator's output (the schedule's setpoint); fill_time_s: the rigid
+//     #   chamber's time constant V_ref / (C R T). Without valves a cavity IS at its
+//     #   setpoint (pressure control), which has no nearby equilibrium past a
+//     #   chamber's pressure maximum (thin walls balloon).
 //     # weightless_inflated: the voxel study's inflated bladder voxels get no gravity
 //     # timing: schedule (columns of column_s) or voxel (the lattice's column
 //     # lengths: actuation phase + settle with every foot active); growth implies voxel.
@@ -134,6 +144,7 @@ struct Scene {
   Eigen::Vector3d gravity = Eigen::Vector3d::Zero();
   std::vector<CavitySpec> cavities;
   std::vector<GasCavitySpec> gas_cavities;
+  std::vector<VolumeControlSpec> volume_cavities;
   std::vector<TractionSpec> tractions;
   std::vector<PullSpringSpec> pulls;  // fem/pull_spring.h; force in tables "pulls" and summary.json
   // Code-built scenes only: a body force b(X, t) [N/m^3] on every cell (e.g. a

@@ -128,6 +128,8 @@ Mesh build_scene_mesh(const Scene& scene, MPI_Comm comm) {
   for (const auto& p : scene.pulls) require_surface(scene, mesh, p.surface, p.where, "loads.pulls");
   for (const auto& c : scene.gas_cavities)
     for (const auto& s : c.wall.surfaces) require_surface(scene, mesh, s, "", "loads.gas_cavities." + c.wall.name);
+  for (const auto& c : scene.volume_cavities)
+    for (const auto& s : c.wall.surfaces) require_surface(scene, mesh, s, "", "loads.volume_cavities." + c.wall.name);
   if (scene.ground_contact)
     for (const auto& surface : scene.ground.surfaces)
       require_surface(scene, mesh, surface, "", "contact.ground.surfaces");
@@ -214,6 +216,11 @@ SimulationResult run_scene(const Scene& scene, MPI_Comm comm, const RunOptions& 
     gas_cavities.push_back(std::make_shared<GasCavityTerm>(mesh, partition, rank, spec));
     assembler.add_term(gas_cavities.back());
   }
+  std::vector<std::shared_ptr<VolumeControlledCavityTerm>> volume_cavities;
+  for (const auto& spec : scene.volume_cavities) {
+    volume_cavities.push_back(std::make_shared<VolumeControlledCavityTerm>(mesh, partition, rank, spec));
+    assembler.add_term(volume_cavities.back());
+  }
   for (const auto& t : scene.tractions) {
     const Eigen::Vector3d traction = t.traction;
     const TimeFunction scale = t.scale;
@@ -293,6 +300,7 @@ SimulationResult run_scene(const Scene& scene, MPI_Comm comm, const RunOptions& 
   result.dofs = assembler.n_dofs();
   for (const auto& c : cavities) result.cavity_names.push_back(c->spec().name);
   for (const auto& c : gas_cavities) result.cavity_names.push_back(c->spec().wall.name);
+  for (const auto& c : volume_cavities) result.cavity_names.push_back(c->spec().wall.name);
 
   // ---- Output (rank 0 writes; every rank takes part in the gathers).
   const bool write = options.write_output && !scene.output_dir.empty();
@@ -311,6 +319,11 @@ SimulationResult run_scene(const Scene& scene, MPI_Comm comm, const RunOptions& 
     cavity_columns.push_back(c->spec().wall.name + "_pressure_Pa");
     cavity_columns.push_back(c->spec().wall.name + "_volume_m3");
     cavity_columns.push_back(c->spec().wall.name + "_amount_mol");
+  }
+  for (const auto& c : volume_cavities) {
+    cavity_columns.push_back(c->spec().wall.name + "_pressure_Pa");
+    cavity_columns.push_back(c->spec().wall.name + "_volume_m3");
+    cavity_columns.push_back(c->spec().wall.name + "_target_volume_m3");
   }
   std::vector<std::string> pull_columns{"time"};
   for (const auto& p : pulls) {
@@ -352,6 +365,10 @@ SimulationResult run_scene(const Scene& scene, MPI_Comm comm, const RunOptions& 
       result.cavity_volume.push_back(c->volume(assembler, solver.solution()));
     }
     for (const auto& c : gas_cavities) {
+      result.cavity_pressure.push_back(c->pressure());
+      result.cavity_volume.push_back(c->cavity_volume());
+    }
+    for (const auto& c : volume_cavities) {
       result.cavity_pressure.push_back(c->pressure());
       result.cavity_volume.push_back(c->cavity_volume());
     }
@@ -415,6 +432,12 @@ SimulationResult run_scene(const Scene& scene, MPI_Comm comm, const RunOptions& 
         row.push_back(result.cavity_pressure[cavities.size() + i]);
         row.push_back(result.cavity_volume[cavities.size() + i]);
         row.push_back(gas_cavities[i]->amount());
+      }
+      for (size_t i = 0; i < volume_cavities.size(); ++i) {
+        const size_t k = cavities.size() + gas_cavities.size() + i;
+        row.push_back(result.cavity_pressure[k]);
+        row.push_back(result.cavity_volume[k]);
+        row.push_back(volume_cavities[i]->target_volume());
       }
       if (cavity_columns.size() > 1) writer->append_row("cavities", cavity_columns, row);
       if (!pulls.empty()) {

@@ -191,12 +191,9 @@ TEST(GasCavity, ImplicitValveStepSatisfiesBackwardEuler) {
 namespace {
 // Rigid cavity (V fixed at the reference volume) filled through the valve from
 // gauge 0: time [s] at which the gauge pressure first reaches `target` [Pa].
-double rigid_fill_time(const Mesh& mesh, const Partition& partition, double supply, double C, double target,
+double rigid_fill_time(const Mesh& mesh, const Partition& partition, const GasCavitySpec& gas, double target,
                        double dt) {
-  GasCavitySpec gas;
-  gas.wall = {"core", {"inner"}, {true, true, true}, 8.0};
-  gas.supply_gauge_pressure = TimeFunction::constant(supply);
-  gas.conductance = TimeFunction::constant(C);
+  const double supply = gas.supply_gauge_pressure(0.0);
   GasCavityTerm term(mesh, partition, 0, gas);
   const double V = term.reference_volume();
   double t = 0, p_prev = term.pressure();
@@ -210,6 +207,14 @@ double rigid_fill_time(const Mesh& mesh, const Partition& partition, double supp
     p_prev = p;
   }
   return -1;
+}
+
+GasCavitySpec rigid_valve(double supply, double C) {
+  GasCavitySpec gas;
+  gas.wall = {"core", {"inner"}, {true, true, true}, 8.0};
+  gas.supply_gauge_pressure = TimeFunction::constant(supply);
+  gas.conductance = TimeFunction::constant(C);
+  return gas;
 }
 }  // namespace
 
@@ -228,8 +233,8 @@ TEST(GasCavity, RigidFillTimeScalesWithConductanceAndSupply) {
   const double target = 10e3;
   for (double supply : {50e3, 100e3}) {
     const double expected = tau * std::log(supply / (supply - target));
-    const double t1 = rigid_fill_time(mesh, partition, supply, C, target, dt);
-    const double t2 = rigid_fill_time(mesh, partition, supply, 2 * C, target, dt);
+    const double t1 = rigid_fill_time(mesh, partition, rigid_valve(supply, C), target, dt);
+    const double t2 = rigid_fill_time(mesh, partition, rigid_valve(supply, 2 * C), target, dt);
     EXPECT_NEAR(t1, expected, 0.01 * expected) << "supply " << supply;
     EXPECT_NEAR(t2, expected / 2, 0.01 * expected / 2) << "supply " << supply;
   }
@@ -254,4 +259,24 @@ TEST(GasCavity, RigidFillTimeScalesWithConductanceAndSupply) {
   sealed.begin_valve_step(0, 1);
   sealed.end_valve_step(sealed.reference_volume(), 1);
   EXPECT_DOUBLE_EQ(sealed.amount(), n);
+}
+
+// A valve given by its fill time tau instead of a conductance: the rigid cavity's
+// time constant is tau whatever its volume (octant shells of two sizes), so the
+// gauge reaches p* at tau ln(p_s / (p_s - p*)); tau <= 0 is refused.
+TEST(GasCavity, FillTimeSetsTheRigidCavitysTimeConstant) {
+  const double tau = 0.05, supply = 35e3, target = 20e3;
+  const double expected = tau * std::log(supply / (supply - target));
+  for (double A : {0.01, 0.02}) {
+    Mesh mesh = octant_shell(1, A, 1.5 * A, A);
+    Partition partition = partition_mesh(mesh, 1);
+    GasCavitySpec gas = rigid_valve(supply, 1.0);  // the fill time overrides this conductance
+    gas.fill_time = tau;
+    GasCavityTerm term(mesh, partition, 0, gas);
+    EXPECT_NEAR(term.time_constant(term.reference_volume(), term.spec().conductance(0.0)), tau, 1e-12 * tau);
+    EXPECT_NEAR(rigid_fill_time(mesh, partition, gas, target, tau / 400), expected, 0.01 * expected)
+        << "inner radius " << A;
+    gas.fill_time = 0.0;
+    EXPECT_THROW(GasCavityTerm(mesh, partition, 0, gas), std::invalid_argument);
+  }
 }

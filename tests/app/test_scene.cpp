@@ -3,10 +3,12 @@
 #include <gtest/gtest.h>
 #include <petscsys.h>
 
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 
 #include "app/scene.h"
 #include "app/simulation.h"
@@ -265,6 +267,57 @@ output: {directory: OUT}
   EXPECT_TRUE(fs::exists(s.dir / "out" / "balloon.xdmf"));
 }
 
+// The same balloon under volume control (loads.volume_cavities, V*/V_ref to 1.8^3):
+// the run goes through the pressure maximum that stops pressure control, the
+// volume follows V*, and the maximum is the thin-shell one, p = 2 mu H/R (la^-1 -
+// la^-7) with its peak 1.2394 mu H/R at la = 7^(1/6) = 1.383 (R the mid radius).
+TEST(Scene, VolumeControlTracesTheBalloonThroughItsPressureMaximum) {
+  const std::string text = R"(name: balloon_volume
+geometry: {type: spherical_shell, inner_radius: 0.010, outer_radius: 0.0105, mesh_size: 0.003, order: 2}
+materials:
+  body: {model: neo_hookean, mu: 1.0e5, kappa: 1.0e8}
+boundary:
+  - {surface: sym_x, fix: [x]}
+  - {surface: sym_y, fix: [y]}
+  - {surface: sym_z, fix: [z]}
+loads:
+  volume_cavities:
+    - {name: inside, surfaces: [inner], volume_ratio: [[0, 1], [1, 5.832]], penalty_modulus: 2.0e4}
+solver: {end_time: 1, initial_step: 0.02, max_step: 0.02, formulation: mean_dilatation}
+)";
+  for (const auto& [from, to, message] : std::vector<std::array<std::string, 3>>{
+           {"[[0, 1], [1, 5.832]]", "[[0, 1], [1, -2]]", "volume ratios must be positive"},
+           {"[[0, 1], [1, 5.832]]", "3.0", "expected a table"},
+           {", penalty_modulus: 2.0e4", "", "missing key 'penalty_modulus'"},
+           {"2.0e4", "-1", "loads.volume_cavities.penalty_modulus"},
+           {"[inner]", "[nowhere]", "nowhere"}}) {
+    const std::string e = error_of(replace(text, from, to));
+    EXPECT_NE(e.find(message), std::string::npos) << to << ": " << e;
+  }
+  TempScene s(text);
+  Scene scene = read_scene(s.file.string());
+  ASSERT_EQ(scene.volume_cavities.size(), 1u);
+  std::vector<std::pair<double, double>> curve;  // (inner stretch, gauge pressure)
+  double worst = 0, V_ref = 0;
+  RunOptions options{false, false, {}};
+  options.on_step = [&](double t, const Mesh&, const RowMatrixXd&, const SimulationResult& r) {
+    if (t == 0.0) V_ref = r.cavity_volume.at(0);  // the first record is the reference state
+    const double ratio = r.cavity_volume.at(0) / V_ref;
+    worst = std::max(worst, std::abs(ratio / (1 + 4.832 * t) - 1));
+    curve.emplace_back(std::cbrt(ratio), r.cavity_pressure.at(0));
+  };
+  auto r = run_scene(scene, PETSC_COMM_WORLD, options);
+  ASSERT_TRUE(r.stats.completed) << r.stats.failure;
+  auto peak = std::max_element(curve.begin(), curve.end(), [](auto& a, auto& b) { return a.second < b.second; });
+  const double mu = 1e5, H = 0.0005, R = 0.01025, p_max = 1.2394 * mu * H / R;
+  std::cout << "peak " << peak->second << " Pa at stretch " << peak->first << " (thin shell " << p_max
+            << " Pa at 1.383); end " << curve.back().second << " Pa; worst |V/V* - 1| " << worst << "\n";
+  EXPECT_LT(worst, 1e-5);
+  EXPECT_NEAR(peak->second, p_max, 0.03 * p_max);
+  EXPECT_NEAR(peak->first, 1.383, 0.03);
+  EXPECT_LT(curve.back().second, 0.9 * peak->second);  // past the maximum the pressure falls
+}
+
 // A schedule file drives a cavity: bladder 1 of the rolling schedule (inflated in
 // the 8th column of each repeat) inflates a tube only while the schedule says so.
 TEST(Scene, ScheduleDrivesTheBladderPressure) {
@@ -305,6 +358,72 @@ solver: {end_time: 10.4, initial_step: 0.3, max_step: 0.3}
     }
   }
   EXPECT_EQ(checked, 2);
+}
+
+// actuation.valves: the scheduled cavity holds gas fed through a valve whose supply
+// is the schedule's setpoint. With a fast valve (fill time 5 ms) the tube in column
+// 8 (b1 inflated, 0.2 s ramp) sits at the setpoint and at the pressure-controlled
+// volume; a slow one (2 s, the rigid tube's time constant) lags well behind. Bad
+// valve keys name their key.
+TEST(Scene, ValvesFeedTheScheduledCavityFromItsSetpoint) {
+  const std::string schedule = std::string(MORPHFEM_SOURCE_DIR) + "/examples/schedules/rolling.yaml";
+  const std::string text = R"(name: valve_tube
+geometry: {type: thick_cylinder, inner_radius: 0.005, outer_radius: 0.02, mesh_size: 0.004, order: 1}
+materials:
+  body: {model: dragon_skin_10}
+boundary:
+  - {surface: sym_x, fix: [x]}
+  - {surface: sym_y, fix: [y]}
+  - {surface: zmin, fix: [z]}
+  - {surface: zmax, fix: [z]}
+actuation: {schedule: )" + schedule +
+                           R"(, start: 0.5, bladders: {b1: inner}, volume_axes: [x, y]VALVES}
+solver: {end_time: 10.4, initial_step: 0.05, max_step: 0.05}
+)";
+  const double t8 = 0.5 + 7.5 * 1.237;  // middle of column 8 (0.42 s after its ramp ended)
+  auto at_column_8 = [&](const std::string& valves, double& pressure, double& volume) {
+    TempScene s(replace(text, "VALVES", valves));
+    Scene scene = read_scene(s.file.string());
+    RunOptions options{false, false, {}};
+    options.on_step = [&](double t, const Mesh&, const RowMatrixXd&, const SimulationResult& r) {
+      if (std::abs(t - t8) < 1e-9) {
+        pressure = r.cavity_pressure.at(0);
+        volume = r.cavity_volume.at(0);
+      }
+    };
+    scene.solver.output_times = {t8};
+    scene.solver.t_end = t8;
+    auto r = run_scene(scene, PETSC_COMM_WORLD, options);
+    EXPECT_TRUE(r.stats.completed) << r.stats.failure;
+    return scene;
+  };
+  double p_set = 0, v_set = 0, p_fast = 0, v_fast = 0, p_slow = 0, v_slow = 0;
+  const Scene controlled = at_column_8("", p_set, v_set);
+  const Scene fast = at_column_8(", valves: {fill_time_s: 0.005}", p_fast, v_fast);
+  at_column_8(", valves: {fill_time_s: 2.0}", p_slow, v_slow);
+  ASSERT_EQ(controlled.cavities.size(), 1u);
+  ASSERT_TRUE(controlled.gas_cavities.empty());
+  ASSERT_EQ(fast.gas_cavities.size(), 1u);
+  ASSERT_TRUE(fast.cavities.empty());
+  for (double t : {0.0, 0.6, 2.0, t8})
+    EXPECT_DOUBLE_EQ(fast.gas_cavities[0].supply_gauge_pressure(t), controlled.cavities[0].pressure(t)) << t;
+  std::cout << "column 8: setpoint " << p_set << " Pa, V " << v_set << " m^3; fast valve " << p_fast << " Pa, V "
+            << v_fast << " m^3; slow valve " << p_slow << " Pa, V " << v_slow << " m^3\n";
+  EXPECT_NEAR(p_set, 25e3, 1e-6);
+  EXPECT_NEAR(p_fast, 25e3, 0.01 * 25e3);
+  EXPECT_NEAR(v_fast, v_set, 0.01 * v_set);
+  EXPECT_LT(p_slow, 0.5 * 25e3);
+  EXPECT_LT(v_slow, v_set);
+  const std::string bad = replace(text, "VALVES", ", valves: {KEY}");
+  std::string e = error_of(replace(bad, "KEY", "fill_time_s: 0.1, conductance: 1e-8"));
+  EXPECT_NE(e.find("exactly one of fill_time_s"), std::string::npos) << e;
+  e = error_of(replace(bad, "KEY", "temperature: 300"));
+  EXPECT_NE(e.find("exactly one of fill_time_s"), std::string::npos) << e;
+  e = error_of(replace(bad, "KEY", "fill_time_s: -1"));
+  EXPECT_NE(e.find("actuation.valves.fill_time_s"), std::string::npos) << e;
+  EXPECT_NE(e.find("must be positive"), std::string::npos) << e;
+  e = error_of(replace(bad, "KEY", "fill_time: 0.1"));
+  EXPECT_NE(e.find("actuation.valves"), std::string::npos) << e;
 }
 
 // Open-sleeve and weightless keys: bad values name their key; the open axis sets the
