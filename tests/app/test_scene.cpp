@@ -233,19 +233,22 @@ TEST(Scene, GasCavityFillsTowardsTheSupplyPressure) {
   EXPECT_LT(pressure.back(), 5000.0);  // below the 5 kPa supply
 }
 
-// A thin neo-Hookean balloon under pressure control past its maximum
-// (1.239 mu H/R): the run stops with a diagnostic, keeps the last converged state
-// in the output (status "failed" in summary.json) and writes no NaN.
-TEST(Scene, PressureControlPastTheLimitPointFailsGracefully) {
-  TempScene s(R"(name: balloon
-geometry: {type: spherical_shell, inner_radius: 0.010, outer_radius: 0.0105, mesh_size: 0.003, order: 2}
+// An octant of a thin neo-Hookean balloon, H/R = 0.05 (the scenes add name and loads).
+constexpr const char* kThinBalloon =
+    R"(geometry: {type: spherical_shell, inner_radius: 0.010, outer_radius: 0.0105, mesh_size: 0.003, order: 2}
 materials:
   body: {model: neo_hookean, mu: 1.0e5, kappa: 1.0e8}
 boundary:
   - {surface: sym_x, fix: [x]}
   - {surface: sym_y, fix: [y]}
   - {surface: sym_z, fix: [z]}
-loads:
+)";
+
+// A thin neo-Hookean balloon under pressure control past its maximum
+// (1.239 mu H/R): the run stops with a diagnostic, keeps the last converged state
+// in the output (status "failed" in summary.json) and writes no NaN.
+TEST(Scene, PressureControlPastTheLimitPointFailsGracefully) {
+  TempScene s("name: balloon\n" + std::string(kThinBalloon) + R"(loads:
   cavities:
     - {name: inside, surfaces: [inner], pressure: 9000}
 solver: {end_time: 1, initial_step: 0.1, max_step: 0.1, min_step: 1.0e-3, formulation: mean_dilatation}
@@ -272,15 +275,7 @@ output: {directory: OUT}
 // volume follows V*, and the maximum is the thin-shell one, p = 2 mu H/R (la^-1 -
 // la^-7) with its peak 1.2394 mu H/R at la = 7^(1/6) = 1.383 (R the mid radius).
 TEST(Scene, VolumeControlTracesTheBalloonThroughItsPressureMaximum) {
-  const std::string text = R"(name: balloon_volume
-geometry: {type: spherical_shell, inner_radius: 0.010, outer_radius: 0.0105, mesh_size: 0.003, order: 2}
-materials:
-  body: {model: neo_hookean, mu: 1.0e5, kappa: 1.0e8}
-boundary:
-  - {surface: sym_x, fix: [x]}
-  - {surface: sym_y, fix: [y]}
-  - {surface: sym_z, fix: [z]}
-loads:
+  const std::string text = "name: balloon_volume\n" + std::string(kThinBalloon) + R"(loads:
   volume_cavities:
     - {name: inside, surfaces: [inner], volume_ratio: [[0, 1], [1, 5.832]], penalty_modulus: 2.0e4}
 solver: {end_time: 1, initial_step: 0.02, max_step: 0.02, formulation: mean_dilatation}
