@@ -313,12 +313,11 @@ solver: {end_time: 1, initial_step: 0.02, max_step: 0.02, formulation: mean_dila
   EXPECT_LT(curve.back().second, 0.9 * peak->second);  // past the maximum the pressure falls
 }
 
-// A schedule file drives a cavity: bladder 1 of the rolling schedule (inflated in
-// the 8th column of each repeat) inflates a tube only while the schedule says so.
-TEST(Scene, ScheduleDrivesTheBladderPressure) {
+// A quarter of a thick DS10 tube in plane strain whose bore is bladder 1 of the
+// rolling schedule (gait from t = 0.5 s); `extra` goes into the actuation map.
+static std::string scheduled_tube(const std::string& extra) {
   const std::string schedule = std::string(MORPHFEM_SOURCE_DIR) + "/examples/schedules/rolling.yaml";
-  TempScene s(R"(name: scheduled_tube
-geometry: {type: thick_cylinder, inner_radius: 0.005, outer_radius: 0.02, mesh_size: 0.004, order: 1}
+  return R"(geometry: {type: thick_cylinder, inner_radius: 0.005, outer_radius: 0.02, mesh_size: 0.004, order: 1}
 materials:
   body: {model: dragon_skin_10}
 boundary:
@@ -327,7 +326,13 @@ boundary:
   - {surface: zmin, fix: [z]}
   - {surface: zmax, fix: [z]}
 actuation: {schedule: )" +
-              schedule + R"(, start: 0.5, bladders: {b1: inner}, volume_axes: [x, y]}
+         schedule + ", start: 0.5, bladders: {b1: inner}, volume_axes: [x, y]" + extra + "}\n";
+}
+
+// A schedule file drives a cavity: bladder 1 of the rolling schedule (inflated in
+// the 8th column of each repeat) inflates a tube only while the schedule says so.
+TEST(Scene, ScheduleDrivesTheBladderPressure) {
+  TempScene s("name: scheduled_tube\n" + scheduled_tube("") + R"(
 solver: {end_time: 10.4, initial_step: 0.3, max_step: 0.3}
 )");
   Scene scene = read_scene(s.file.string());
@@ -361,18 +366,7 @@ solver: {end_time: 10.4, initial_step: 0.3, max_step: 0.3}
 // volume; a slow one (2 s, the rigid tube's time constant) lags well behind. Bad
 // valve keys name their key.
 TEST(Scene, ValvesFeedTheScheduledCavityFromItsSetpoint) {
-  const std::string schedule = std::string(MORPHFEM_SOURCE_DIR) + "/examples/schedules/rolling.yaml";
-  const std::string text = R"(name: valve_tube
-geometry: {type: thick_cylinder, inner_radius: 0.005, outer_radius: 0.02, mesh_size: 0.004, order: 1}
-materials:
-  body: {model: dragon_skin_10}
-boundary:
-  - {surface: sym_x, fix: [x]}
-  - {surface: sym_y, fix: [y]}
-  - {surface: zmin, fix: [z]}
-  - {surface: zmax, fix: [z]}
-actuation: {schedule: )" + schedule +
-                           R"(, start: 0.5, bladders: {b1: inner}, volume_axes: [x, y]VALVES}
+  const std::string text = "name: valve_tube\n" + scheduled_tube("VALVES") + R"(
 solver: {end_time: 10.4, initial_step: 0.05, max_step: 0.05}
 )";
   const double t8 = 0.5 + 7.5 * 1.237;  // middle of column 8 (0.42 s after its ramp ended)
