@@ -4,9 +4,9 @@
     /usr/bin/python3 scripts/chamber_pv.py RESULT.h5 [--cavity b1] [--png OUT.png] [--every N]
 
 Prints, per cavity, time, V/V_ref (V_ref the first row's volume), gauge pressure
-[kPa], and the largest pressure with its volume ratio (a pressure maximum inside
-the run means pressure control has no nearby equilibrium past it). Writes a PNG
-of pressure against V/V_ref.
+[kPa], and the largest pressure with its volume ratio, called a pressure maximum
+when the chamber later holds more volume at a lower pressure (pressure control has
+no nearby equilibrium past it). Writes a PNG of pressure against V/V_ref.
 """
 import argparse
 import sys
@@ -53,7 +53,10 @@ def main():
         for i in range(0, len(t), max(1, a.every)):
             print(f"{t[i]:8.3f} {ratio[i]:8.3f} {p[i] / 1e3:9.3f}")
         k = int(np.argmax(p))
-        where = "at the end of the run" if k == len(p) - 1 else "inside the run: a pressure maximum"
+        # A pressure maximum of the wall: later states hold more volume at a lower
+        # pressure (a setpoint plateau or a deflation is not one).
+        later = (ratio[k + 1 :] > ratio[k]) & (p[k + 1 :] < 0.99 * p[k])
+        where = "a pressure maximum: the chamber grows past it at falling pressure" if later.any() else "not a maximum"
         print(f"largest pressure {p[k] / 1e3:.3f} kPa at V/V_ref {ratio[k]:.3f} (t = {t[k]:.3f} s), {where}")
     if a.png:
         import matplotlib
