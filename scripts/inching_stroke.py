@@ -8,7 +8,10 @@ After `--start` (the end of settling) it prints
     stroke the chambers make each cycle (0 if the body cannot bend);
   * each foot's travel along y from `--start` to the last saved step;
   * the belly's lowest height over the run (the ground plane's height is the scene's
-    contact point: a belly within the barrier width dhat of it is touching).
+    contact point: a belly within the barrier width dhat of it is touching);
+  * each foot's largest pull |F_y| / N over the saved steps after `--start` (friction
+    force along the body over normal force, summed over the foot's nodes): a foot
+    slides only when its pull reaches its friction coefficient.
 Used for the physical inching ladder in the README.
 
     /usr/bin/python3 scripts/inching_stroke.py RESULTS/CASE.h5 [--start 1.0] [--foot 0.02] [--pad 0.004]
@@ -47,7 +50,15 @@ def main():
     if not later.any():
         sys.exit(f"inching_stroke.py: {args.h5}: no saved step after --start {args.start} s")
     distance, ya, yb, belly_z = [], [], [], []
-    for s in steps:
+    pull = {"A": 0.0, "B": 0.0}
+    for k, s in enumerate(steps):
+        g = f["/steps/" + s]
+        if later[k] and "friction_force_N" in g and "contact_force_N" in g:
+            normal, friction = g["contact_force_N"][:], g["friction_force_N"][:]
+            for name, foot in (("A", foot_a), ("B", foot_b)):
+                n = np.linalg.norm(normal[foot], axis=1).sum()
+                if n > 0:
+                    pull[name] = max(pull[name], abs(friction[foot, 1].sum()) / n)
         x = X + f["/steps/" + s + "/displacement"][:]
         ya.append(x[foot_a, 1].mean())
         yb.append(x[foot_b, 1].mean())
@@ -58,7 +69,8 @@ def main():
     print(f"feet distance {1e3 * distance.min():.2f} .. {1e3 * distance.max():.2f} mm: stroke "
           f"{1e3 * (distance.max() - distance.min()):.3f} mm; travel foot A {1e3 * (ya[-1] - ya[first]):.2f} mm, "
           f"foot B {1e3 * (yb[-1] - yb[first]):.2f} mm; belly lowest at z = {1e3 * min(belly_z):.3f} mm "
-          f"(reference {1e3 * z[belly].min():.3f} mm)")
+          f"(reference {1e3 * z[belly].min():.3f} mm); largest pull |F_y|/N foot A {pull['A']:.3f}, "
+          f"foot B {pull['B']:.3f}")
 
 
 if __name__ == "__main__":
