@@ -388,10 +388,15 @@ TEST(PlayerFault, Rupture) {
   EmulatorConfig cfg;
   cfg.rupture_pa = 20000;  // below the 25 kPa the gait asks for
   Rig rig("rupture", false, cfg);
-  int code = rig.play(read_schedule(kExamples + "rolling.yaml"));
-  // b8 ruptures first (column 1) but its column ends before the 1 s fault delay;
-  // b7 or b6, inflated next, also rupture, and the player stops there.
-  expect_fault_handled(rig, code, kExitFault, "tracking fault on b");
+  // 3 s columns: b8 (column 1) ruptures on its ramp and stays commanded to 25 kPa
+  // for about 2.8 s of schedule time, well past the default 1 s fault delay. With the
+  // gait's 1.237 s columns that margin was about 0.07 s (7 ms of wall time at the
+  // rig's 10x), and on a loaded machine the column could end first (seen in CI:
+  // exit 0, no fault).
+  Schedule s = read_schedule(kExamples + "rolling.yaml");
+  s.column_s = 3.0;
+  int code = rig.play(s);
+  expect_fault_handled(rig, code, kExitFault, "tracking fault on b8");
   EXPECT_NE(rig.err.str().find("ruptured bladder"), std::string::npos);
   EXPECT_TRUE(rig.emu->channel(7).ruptured);
 }
