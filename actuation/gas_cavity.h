@@ -75,6 +75,12 @@ class CavityVolumeTerm : public EnergyTerm {
   Eigen::VectorXd local_volume_gradient(const RowMatrixXd& u_all) const;
   // The dense rank-1 coefficient c of H += c v v^T, v = dV_m/du, at the cached V.
   double low_rank_coefficient() const { return wall_.symmetry_factor * energy_second_derivative(volume_); }
+  // Gauge pressure [Pa] at the last converged state.
+  virtual double pressure() const = 0;
+  // The cavity's own state beside p and V, for result tables: its name with unit
+  // (a column suffix) and value at the last converged state.
+  virtual std::string state_column() const = 0;
+  virtual double state_value() const = 0;
   // Whole-cavity energy Phi(V) [J] and its derivatives [Pa], [Pa/m^3], at the
   // term's current parameters; Phi(V) = +inf outside the domain (V <= 0).
   virtual double energy_of_volume(double V) const = 0;
@@ -169,9 +175,11 @@ class GasCavityTerm : public CavityVolumeTerm {
   void end_valve_step(double V1, double t1);
 
   // At the last converged state (last converged state after end_step):
-  double absolute_pressure() const;                                                     // p [Pa]
-  double pressure() const { return absolute_pressure() - spec_.atmospheric_pressure; }  // gauge [Pa]
-  double amount() const { return amount_; }                                             // n [mol]
+  double absolute_pressure() const;                                                              // p [Pa]
+  double pressure() const override { return absolute_pressure() - spec_.atmospheric_pressure; }  // gauge [Pa]
+  double amount() const { return amount_; }                                                      // n [mol]
+  std::string state_column() const override { return "amount_mol"; }
+  double state_value() const override { return amount_; }
   double molar_flow_rate() const { return flow_rate_; }  // (n1 - n0)/dt of the last step [mol/s]
   // Sets the gas amount [mol] (e.g. a sealed cavity filled to a given state).
   void set_amount(double n);
@@ -229,8 +237,10 @@ class VolumeControlledCavityTerm : public CavityVolumeTerm {
   double energy_derivative(double V) const override;
   double energy_second_derivative(double V) const override { return penalty_; }
 
-  double pressure() const { return converged_pressure_; }  // gauge [Pa], last converged state
-  double target_volume() const { return target_; }         // V*(t) [m^3]
+  double pressure() const override { return converged_pressure_; }  // gauge [Pa], last converged state
+  double target_volume() const { return target_; }                  // V*(t) [m^3]
+  std::string state_column() const override { return "target_volume_m3"; }
+  double state_value() const override { return target_; }
   double multiplier() const { return multiplier_; }
   double penalty() const { return penalty_; }
   int outer_updates() const { return outer_updates_; }  // total multiplier updates so far

@@ -74,6 +74,16 @@ struct Reader {
           {key, path.string(), sha256_file(path.string()), calibration.kind, name, value->value, value->std_error});
     return value->value;
   }
+  // A number (or, if `calibrated`, a calibrated value) that must be > 0.
+  double positive(const YAML::Node& node, const std::string& key, bool calibrated = false) const {
+    const double v = calibrated ? calibrated_number(node, key) : number(node, key);
+    if (!(v > 0)) fail(node, key, "must be positive");
+    return v;
+  }
+  // The optional key map[k] (path where.k): a positive number into out, out untouched if absent.
+  void optional_positive(const YAML::Node& map, const std::string& where, const char* k, double& out) const {
+    if (map[k]) out = positive(map[k], where + "." + k);
+  }
   Eigen::Vector3d vector3(const YAML::Node& node, const std::string& key) const {
     if (!node.IsSequence() || node.size() != 3) fail(node, key, "expected a list of 3 numbers [x, y, z]");
     return {number(node[0], key), number(node[1], key), number(node[2], key)};
@@ -189,12 +199,7 @@ Scene scene_from_yaml(const YAML::Node& root, const std::string& path) {
     r.allow(s, "solver",
             {"end_time", "initial_step", "min_step", "max_step", "linear_solver", "quadrature_degree", "max_newton_its",
              "rtol", "formulation"});
-    auto positive = [&](const char* key, double& out) {
-      if (s[key]) {
-        out = r.number(s[key], std::string("solver.") + key);
-        if (!(out > 0)) r.fail(s[key], std::string("solver.") + key, "must be positive");
-      }
-    };
+    auto positive = [&](const char* key, double& out) { r.optional_positive(s, "solver", key, out); };
     positive("end_time", scene.solver.t_end);
     positive("initial_step", scene.solver.dt_initial);
     positive("min_step", scene.solver.dt_min);
@@ -327,13 +332,8 @@ Scene scene_from_yaml(const YAML::Node& root, const std::string& path) {
         spec.wall.surfaces = r.texts(c["surfaces"], key + ".surfaces");
         if (c["volume_axes"]) spec.wall.axes = r.axes(c["volume_axes"], key + ".volume_axes");
         r.open_axis(c, key, spec.wall.axes, spec.wall.open_axis);
-        auto positive = [&](const char* k, double& out) {
-          if (!c[k]) return;
-          out = r.number(c[k], key + "." + k);
-          if (!(out > 0)) r.fail(c[k], key + "." + k, "must be positive");
-        };
-        positive("symmetry_factor", spec.wall.symmetry_factor);
-        positive("temperature", spec.temperature);
+        r.optional_positive(c, key, "symmetry_factor", spec.wall.symmetry_factor);
+        r.optional_positive(c, key, "temperature", spec.temperature);
         if (c["initial_gauge_pressure"])
           spec.initial_gauge_pressure = r.number(c["initial_gauge_pressure"], key + ".initial_gauge_pressure");
         // A number (or a calibrated value) held constant, or a table [[t, value], ...].
@@ -373,12 +373,8 @@ Scene scene_from_yaml(const YAML::Node& root, const std::string& path) {
         spec.volume_is_ratio = true;
         for (const auto& [t, v] : spec.volume.points())
           if (!(v > 0)) r.fail(c["volume_ratio"], key + ".volume_ratio", "volume ratios must be positive");
-        spec.penalty_modulus = r.number(c["penalty_modulus"], key + ".penalty_modulus");
-        if (!(spec.penalty_modulus > 0)) r.fail(c["penalty_modulus"], key + ".penalty_modulus", "must be positive");
-        if (c["tolerance"]) {
-          spec.tolerance = r.number(c["tolerance"], key + ".tolerance");
-          if (!(spec.tolerance > 0)) r.fail(c["tolerance"], key + ".tolerance", "must be positive");
-        }
+        spec.penalty_modulus = r.positive(c["penalty_modulus"], key + ".penalty_modulus");
+        r.optional_positive(c, key, "tolerance", spec.tolerance);
         scene.volume_cavities.push_back(spec);
       }
     }
@@ -465,10 +461,7 @@ Scene scene_from_yaml(const YAML::Node& root, const std::string& path) {
       r.allow(f, "contact.friction", {"eps_v", "lag_updates", "regions"});
       if (!scene.ground_contact) r.fail(f, "contact.friction", "friction needs contact.ground");
       scene.friction = true;
-      if (f["eps_v"]) {
-        scene.friction_spec.eps_v = r.number(f["eps_v"], "contact.friction.eps_v");
-        if (!(scene.friction_spec.eps_v > 0)) r.fail(f["eps_v"], "contact.friction.eps_v", "must be positive");
-      }
+      r.optional_positive(f, "contact.friction", "eps_v", scene.friction_spec.eps_v);
       if (f["lag_updates"])
         scene.friction_spec.lag_updates = int(r.number(f["lag_updates"], "contact.friction.lag_updates"));
       if (!f["regions"] || !f["regions"].IsSequence())
@@ -580,11 +573,7 @@ Scene scene_from_yaml(const YAML::Node& root, const std::string& path) {
       r.allow(valves, vkey, {"fill_time_s", "conductance", "temperature"});
       if (static_cast<bool>(valves["fill_time_s"]) == static_cast<bool>(valves["conductance"]))
         r.fail(valves, vkey, "give exactly one of fill_time_s [s] and conductance [mol/(s Pa)]");
-      auto positive = [&](const char* k) {
-        const double v = r.calibrated_number(valves[k], vkey + "." + k);
-        if (!(v > 0)) r.fail(valves[k], vkey + "." + k, "must be positive");
-        return v;
-      };
+      auto positive = [&](const char* k) { return r.positive(valves[k], vkey + "." + k, true); };
       if (valves["fill_time_s"]) valve.fill_time = positive("fill_time_s");
       if (valves["conductance"]) valve.conductance = TimeFunction::constant(positive("conductance"));
       if (valves["temperature"]) valve.temperature = positive("temperature");

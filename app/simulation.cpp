@@ -2,12 +2,15 @@
 
 #include <mpi.h>
 
+#include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <limits>
+#include <map>
 #include <stdexcept>
 
 #include "actuation/cavity.h"
@@ -107,6 +110,30 @@ void require_surface(const Scene& scene, const Mesh& mesh, const std::string& na
 }
 
 }  // namespace
+
+double contact_shear_modulus(const Mesh& mesh, const std::vector<std::shared_ptr<const Material>>& materials,
+                             const std::vector<std::string>& surfaces) {
+  // Cell faces by their sorted vertex triple -> the cell's region.
+  std::map<std::array<int, 3>, int> face_region;
+  static constexpr int kFace[4][3] = {{0, 1, 2}, {0, 1, 3}, {0, 2, 3}, {1, 2, 3}};
+  for (int c = 0; c < mesh.n_cells(); ++c)
+    for (const auto& f : kFace) {
+      std::array<int, 3> key{mesh.cells(c, f[0]), mesh.cells(c, f[1]), mesh.cells(c, f[2])};
+      std::sort(key.begin(), key.end());
+      face_region[key] = mesh.cell_region[c];
+    }
+  std::vector<double> area(mesh.regions.size(), 0.0);
+  for (const auto& s : surfaces)
+    for (int f : mesh.faces_of(s)) {
+      std::array<int, 3> key{mesh.faces(f, 0), mesh.faces(f, 1), mesh.faces(f, 2)};
+      const Eigen::Vector3d x0 = mesh.X.row(key[0]), x1 = mesh.X.row(key[1]), x2 = mesh.X.row(key[2]);
+      std::sort(key.begin(), key.end());
+      const auto it = face_region.find(key);
+      if (it != face_region.end()) area[it->second] += 0.5 * (x1 - x0).cross(x2 - x0).norm();
+    }
+  const auto most = std::max_element(area.begin(), area.end()) - area.begin();
+  return area[most] > 0 && materials[most] ? materials[most]->shear_modulus() : 0.0;
+}
 
 Mesh build_scene_mesh(const Scene& scene, MPI_Comm comm) {
   Mesh mesh = build_on_root(scene, comm);
@@ -211,16 +238,13 @@ SimulationResult run_scene(const Scene& scene, MPI_Comm comm, const RunOptions& 
     cavities.push_back(std::make_shared<CavityPressureTerm>(mesh, partition, rank, spec));
     assembler.add_term(cavities.back());
   }
-  std::vector<std::shared_ptr<GasCavityTerm>> gas_cavities;
-  for (const auto& spec : scene.gas_cavities) {
-    gas_cavities.push_back(std::make_shared<GasCavityTerm>(mesh, partition, rank, spec));
-    assembler.add_term(gas_cavities.back());
-  }
-  std::vector<std::shared_ptr<VolumeControlledCavityTerm>> volume_cavities;
-  for (const auto& spec : scene.volume_cavities) {
+  // Cavities whose pressure follows from their volume: gas-filled, then volume-controlled.
+  std::vector<std::shared_ptr<CavityVolumeTerm>> volume_cavities;
+  for (const auto& spec : scene.gas_cavities)
+    volume_cavities.push_back(std::make_shared<GasCavityTerm>(mesh, partition, rank, spec));
+  for (const auto& spec : scene.volume_cavities)
     volume_cavities.push_back(std::make_shared<VolumeControlledCavityTerm>(mesh, partition, rank, spec));
-    assembler.add_term(volume_cavities.back());
-  }
+  for (const auto& c : volume_cavities) assembler.add_term(c);
   for (const auto& t : scene.tractions) {
     const Eigen::Vector3d traction = t.traction;
     const TimeFunction scale = t.scale;
@@ -254,10 +278,8 @@ SimulationResult run_scene(const Scene& scene, MPI_Comm comm, const RunOptions& 
   std::shared_ptr<FrictionTerm> friction;
   if (scene.ground_contact) {
     GroundContactSpec spec = scene.ground;
-    double mu_max = 0;
-    for (const auto& m : materials)
-      if (m) mu_max = std::max(mu_max, m->shear_modulus());
-    spec.young_modulus = 3.0 * mu_max;  // nearly incompressible: E = 2 mu (1 + nu) ~ 3 mu
+    // nearly incompressible: E = 2 mu (1 + nu) ~ 3 mu
+    spec.young_modulus = 3.0 * contact_shear_modulus(mesh, materials, spec.surfaces);
     ground = std::make_shared<GroundContactTerm>(mesh, partition, rank, spec);
     assembler.add_term(ground);
     if (scene.friction) {
@@ -269,10 +291,9 @@ SimulationResult run_scene(const Scene& scene, MPI_Comm comm, const RunOptions& 
   std::shared_ptr<SelfContactTerm> self_contact;
   if (scene.self_contact) {
     SelfContactSpec spec = scene.self_contact_spec;
-    double mu_max = 0;
-    for (const auto& m : materials)
-      if (m) mu_max = std::max(mu_max, m->shear_modulus());
-    spec.young_modulus = 3.0 * mu_max;  // as for the ground: E ~ 3 mu
+    std::vector<std::string> surfaces;
+    for (const auto& [a, b] : spec.pairs) surfaces.insert(surfaces.end(), {a, b});
+    spec.young_modulus = 3.0 * contact_shear_modulus(mesh, materials, surfaces);  // as for the ground
     self_contact = std::make_shared<SelfContactTerm>(mesh, partition, rank, spec);
     assembler.add_term(self_contact);
   }
@@ -299,8 +320,7 @@ SimulationResult run_scene(const Scene& scene, MPI_Comm comm, const RunOptions& 
   }
   result.dofs = assembler.n_dofs();
   for (const auto& c : cavities) result.cavity_names.push_back(c->spec().name);
-  for (const auto& c : gas_cavities) result.cavity_names.push_back(c->spec().wall.name);
-  for (const auto& c : volume_cavities) result.cavity_names.push_back(c->spec().wall.name);
+  for (const auto& c : volume_cavities) result.cavity_names.push_back(c->wall().name);
 
   // ---- Output (rank 0 writes; every rank takes part in the gathers).
   const bool write = options.write_output && !scene.output_dir.empty();
@@ -315,15 +335,10 @@ SimulationResult run_scene(const Scene& scene, MPI_Comm comm, const RunOptions& 
     cavity_columns.push_back(c->spec().name + "_pressure_Pa");
     cavity_columns.push_back(c->spec().name + "_volume_m3");
   }
-  for (const auto& c : gas_cavities) {
-    cavity_columns.push_back(c->spec().wall.name + "_pressure_Pa");
-    cavity_columns.push_back(c->spec().wall.name + "_volume_m3");
-    cavity_columns.push_back(c->spec().wall.name + "_amount_mol");
-  }
   for (const auto& c : volume_cavities) {
-    cavity_columns.push_back(c->spec().wall.name + "_pressure_Pa");
-    cavity_columns.push_back(c->spec().wall.name + "_volume_m3");
-    cavity_columns.push_back(c->spec().wall.name + "_target_volume_m3");
+    cavity_columns.push_back(c->wall().name + "_pressure_Pa");
+    cavity_columns.push_back(c->wall().name + "_volume_m3");
+    cavity_columns.push_back(c->wall().name + "_" + c->state_column());
   }
   std::vector<std::string> pull_columns{"time"};
   for (const auto& p : pulls) {
@@ -363,10 +378,6 @@ SimulationResult run_scene(const Scene& scene, MPI_Comm comm, const RunOptions& 
     for (const auto& c : cavities) {
       result.cavity_pressure.push_back(c->pressure());
       result.cavity_volume.push_back(c->volume(assembler, solver.solution()));
-    }
-    for (const auto& c : gas_cavities) {
-      result.cavity_pressure.push_back(c->pressure());
-      result.cavity_volume.push_back(c->cavity_volume());
     }
     for (const auto& c : volume_cavities) {
       result.cavity_pressure.push_back(c->pressure());
@@ -428,16 +439,10 @@ SimulationResult run_scene(const Scene& scene, MPI_Comm comm, const RunOptions& 
         row.push_back(result.cavity_pressure[i]);
         row.push_back(result.cavity_volume[i]);
       }
-      for (size_t i = 0; i < gas_cavities.size(); ++i) {
+      for (size_t i = 0; i < volume_cavities.size(); ++i) {
         row.push_back(result.cavity_pressure[cavities.size() + i]);
         row.push_back(result.cavity_volume[cavities.size() + i]);
-        row.push_back(gas_cavities[i]->amount());
-      }
-      for (size_t i = 0; i < volume_cavities.size(); ++i) {
-        const size_t k = cavities.size() + gas_cavities.size() + i;
-        row.push_back(result.cavity_pressure[k]);
-        row.push_back(result.cavity_volume[k]);
-        row.push_back(volume_cavities[i]->target_volume());
+        row.push_back(volume_cavities[i]->state_value());
       }
       if (cavity_columns.size() > 1) writer->append_row("cavities", cavity_columns, row);
       if (!pulls.empty()) {

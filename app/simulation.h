@@ -5,9 +5,11 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "app/scene.h"
 #include "fem/assembly.h"
+#include "fem/material.h"
 #include "fem/solver.h"
 #include "mesh/mesh.h"
 #include "mesh/partition.h"
@@ -38,6 +40,17 @@ struct RunOptions {
   // quantity along the load path): time, displacement (all nodes), cavity data.
   std::function<void(double t, const Mesh&, const RowMatrixXd& u, const SimulationResult&)> on_step;
 };
+
+// Shear modulus [Pa] of the material under most of the surfaces' area (each
+// boundary face takes the material of the cell it bounds; 0 if none). The
+// default contact barrier stiffness is E ~ 3 mu of the material a contact presses
+// into, not of the stiffest material in the body: with kappa 2,300x the skin's E
+// (the 100 MPa fabric sheet, whose 0.5 mm edges reach the outer surface, inside a
+// 43 kPa skin) a node entering the barrier rests within sqrt(p / 3 kappa) dhat of
+// its edge, where the barrier is nearly cubic, and Newton converges linearly
+// (residual / 4 per iteration) until it gets there.
+double contact_shear_modulus(const Mesh& mesh, const std::vector<std::shared_ptr<const Material>>& materials,
+                             const std::vector<std::string>& surfaces);
 
 // Builds the mesh the scene asks for on rank 0 and broadcasts it; checks every
 // region name the scene uses. Throws InputError on bad input before any output

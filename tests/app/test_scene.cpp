@@ -9,10 +9,13 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <set>
 
 #include "app/scene.h"
 #include "app/simulation.h"
 #include "core/errors.h"
+#include "fem/material.h"
+#include "mesh/geometry.h"
 
 using namespace morphfem;
 namespace fs = std::filesystem;
@@ -448,4 +451,36 @@ TEST(Scene, OpenSleeveAndWeightlessKeys) {
   EXPECT_NE(e.find("actuation.bladders_open_axis"), std::string::npos) << e;
   e = error_of(std::string(kGood) + "actuation: {schedule: " + schedule + ", core: zmax, bladders_open_axis: y}\n");
   EXPECT_NE(e.find("needs 'bladders'"), std::string::npos) << e;
+}
+
+// The default barrier stiffness comes from the material under the contact surface,
+// not the stiffest in the body: in the physical laminate the 100 MPa fabric sheet's
+// edges reach the outer surface, but the skin lies under nearly all of it.
+TEST(Scene, ContactStiffnessFollowsTheMaterialUnderTheSurface) {
+  ParamSet geometry("geometry");
+  geometry.set_string("type", "robot_physical");
+  geometry.set("mesh_size", 0.02);
+  const Mesh mesh = build_geometry(geometry);
+  auto neo_hookean = [](double mu) {
+    ParamSet p("material");
+    p.set_string("model", "neo_hookean");
+    p.set("mu", mu);
+    p.set("nu", 0.45);
+    return std::shared_ptr<const Material>(make_material(p));
+  };
+  std::vector<std::shared_ptr<const Material>> materials(mesh.regions.size());
+  for (const auto& r : mesh.regions) {
+    if (r.dim != 3) continue;
+    materials[r.id] = neo_hookean(r.name == "skin" ? 4.3e4 : r.name == "fabric" ? 1.0e8 : 1.5e5);
+  }
+  // The stiffest-material rule would pick the fabric here: it touches the outer surface.
+  const auto outer = mesh.nodes_of_surface("outer");
+  const std::set<int> outer_nodes(outer.begin(), outer.end());
+  bool fabric_touches = false;
+  for (int c : mesh.cells_of("fabric"))
+    for (int a = 0; a < mesh.nodes_per_cell(); ++a)
+      fabric_touches = fabric_touches || outer_nodes.count(mesh.cells(c, a));
+  ASSERT_TRUE(fabric_touches);
+  EXPECT_EQ(contact_shear_modulus(mesh, materials, {"bottom", "outer"}), 4.3e4);
+  EXPECT_EQ(contact_shear_modulus(mesh, materials, {"bladder_1_wall"}), 1.5e5);  // the chamber's own DS30
 }
