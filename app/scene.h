@@ -48,6 +48,8 @@
 //      initial_velocity: [0, 0, 0]}                                     # m/s
 //   contact:
 //     ground: {point: [0, 0, 0], normal: [0, 0, 1], surfaces: [zmin], dhat: 0, kappa: 0}
+//             # 0: defaults, dhat 1e-3 x box diagonal, kappa [Pa] 3 mu of the material under
+//             # most of the surfaces' area (contact_shear_modulus, app/simulation.h)
 //     friction: {eps_v: 1e-4, lag_updates: 0,
 //                regions: [{surface: zmin, mu_static: 0.5, mu_kinetic: 0.4}]}
 //                # mu: a number or a table [[t, mu], ...] (coefficients that change over time)
@@ -57,7 +59,8 @@
 //                # dragonskin10.yeoh.c1)
 //     self: {pairs: [[cavity_top, cavity_bottom]], dhat: 0, kappa: 0, inflation: 0, start: 2.0}
 //           # surfaces that may touch (a name twice: within one surface); 0: defaults
-//           # (contact/self_contact.h: dhat 1e-3 x box diagonal, kappa 3 mu, inflation 20 dhat);
+//           # (contact/self_contact.h: dhat 1e-3 x box diagonal, kappa 3 mu of the material
+//           # under the pairs' surfaces, inflation 20 dhat);
 //           # start [s]: the barrier acts only from then on (default: from the start)
 //   actuation:                                  # a schedule file shared with `morphfem hw play`
 //     {schedule: schedules/rolling.yaml, start: 1.0,      # gait time 0 at t = start [s]
