@@ -239,12 +239,12 @@ SimulationResult run_scene(const Scene& scene, MPI_Comm comm, const RunOptions& 
     assembler.add_term(cavities.back());
   }
   // Cavities whose pressure follows from their volume: gas-filled, then volume-controlled.
-  std::vector<std::shared_ptr<CavityVolumeTerm>> volume_cavities;
+  std::vector<std::shared_ptr<CavityVolumeTerm>> volume_driven;
   for (const auto& spec : scene.gas_cavities)
-    volume_cavities.push_back(std::make_shared<GasCavityTerm>(mesh, partition, rank, spec));
+    volume_driven.push_back(std::make_shared<GasCavityTerm>(mesh, partition, rank, spec));
   for (const auto& spec : scene.volume_cavities)
-    volume_cavities.push_back(std::make_shared<VolumeControlledCavityTerm>(mesh, partition, rank, spec));
-  for (const auto& c : volume_cavities) assembler.add_term(c);
+    volume_driven.push_back(std::make_shared<VolumeControlledCavityTerm>(mesh, partition, rank, spec));
+  for (const auto& c : volume_driven) assembler.add_term(c);
   for (const auto& t : scene.tractions) {
     const Eigen::Vector3d traction = t.traction;
     const TimeFunction scale = t.scale;
@@ -320,7 +320,7 @@ SimulationResult run_scene(const Scene& scene, MPI_Comm comm, const RunOptions& 
   }
   result.dofs = assembler.n_dofs();
   for (const auto& c : cavities) result.cavity_names.push_back(c->spec().name);
-  for (const auto& c : volume_cavities) result.cavity_names.push_back(c->wall().name);
+  for (const auto& c : volume_driven) result.cavity_names.push_back(c->wall().name);
 
   // ---- Output (rank 0 writes; every rank takes part in the gathers).
   const bool write = options.write_output && !scene.output_dir.empty();
@@ -335,7 +335,7 @@ SimulationResult run_scene(const Scene& scene, MPI_Comm comm, const RunOptions& 
     cavity_columns.push_back(c->spec().name + "_pressure_Pa");
     cavity_columns.push_back(c->spec().name + "_volume_m3");
   }
-  for (const auto& c : volume_cavities) {
+  for (const auto& c : volume_driven) {
     cavity_columns.push_back(c->wall().name + "_pressure_Pa");
     cavity_columns.push_back(c->wall().name + "_volume_m3");
     cavity_columns.push_back(c->wall().name + "_" + c->state_column());
@@ -379,7 +379,7 @@ SimulationResult run_scene(const Scene& scene, MPI_Comm comm, const RunOptions& 
       result.cavity_pressure.push_back(c->pressure());
       result.cavity_volume.push_back(c->volume(assembler, solver.solution()));
     }
-    for (const auto& c : volume_cavities) {
+    for (const auto& c : volume_driven) {
       result.cavity_pressure.push_back(c->pressure());
       result.cavity_volume.push_back(c->cavity_volume());
     }
@@ -439,10 +439,10 @@ SimulationResult run_scene(const Scene& scene, MPI_Comm comm, const RunOptions& 
         row.push_back(result.cavity_pressure[i]);
         row.push_back(result.cavity_volume[i]);
       }
-      for (size_t i = 0; i < volume_cavities.size(); ++i) {
+      for (size_t i = 0; i < volume_driven.size(); ++i) {
         row.push_back(result.cavity_pressure[cavities.size() + i]);
         row.push_back(result.cavity_volume[cavities.size() + i]);
-        row.push_back(volume_cavities[i]->state_value());
+        row.push_back(volume_driven[i]->state_value());
       }
       if (cavity_columns.size() > 1) writer->append_row("cavities", cavity_columns, row);
       if (!pulls.empty()) {

@@ -301,7 +301,7 @@ Mesh build_robot_voxel(const ParamSet& params) {
 Mesh build_robot_physical(const ParamSet& params) {
   params.allow_only({"type", "mesh_size", "order", "width", "length", "skin_thickness", "fabric_thickness", "core_gap",
                      "edge_width", "end_seal", "bladder_thickness", "bladder_wall", "bladder_width", "foot_length",
-                     "bladder_end_walls", "foot_pad", "fabric"});
+                     "bladder_end_walls", "foot_pad", "fabric", "bladder_bond_width", "bladder_gap"});
   const CommonRobot c = common_robot(params, 0.10, 0.15, 0.001, 0.005, 0.005, 0.003, 0.02, 0.02);
   // 0: chambers open at both ends (no end walls), e.g. for a plane-strain slice in which
   // the chambers run through the whole slice (foot_length 0) as open sleeves.
@@ -327,6 +327,16 @@ Mesh build_robot_physical(const ParamSet& params) {
   // stands on its feet. 0: no pads (the feet are the skin's bottom faces).
   const double pad = params.number_in("foot_pad", 0.0, kHuge, 0.0);
   require(pad == 0.0 || c.foot_length > 0, params, "foot_pad", "foot pads need feet: foot_length > 0");
+  // Chambers bonded to the skin over their full width (default), or only along a
+  // central strip bladder_bond_width wide: the chamber then stands bladder_gap off the
+  // skin on a DS30 strip, so its floor, free on either side of the strip, unfolds
+  // with its roof as a flattened tube does (an air gap in the mesh, not a
+  // zero-thickness unbonded interface; the gap's faces are outside faces).
+  const double bond = params.number_in("bladder_bond_width", 1e-9, c.bladder_width, c.bladder_width);
+  const bool strip = bond < c.bladder_width;
+  const double gap = strip ? length_param(params, "bladder_gap", w) : 0.0;
+  require(strip || !params.has("bladder_gap"), params, "bladder_gap",
+          "a gap needs a chamber bonded along a strip: bladder_bond_width < bladder_width");
 
   Assembly a;
   a.length = c.length;
@@ -334,10 +344,10 @@ Mesh build_robot_physical(const ParamSet& params) {
   a.volume_order = volume_order(!sheet);
   if (pad > 0) a.volume_order.push_back("foot");
   const double hb = c.bladder_thickness, ds = 0.5 * (t - tf);
-  const double base = std::max(0.0, pad - hb);  // lift of the body over the ground plane z = 0
-  const double z_skin = base + hb, z_core = z_skin + t, z_top = z_core + c.core_gap, z_upper = z_top + t;
+  const double base = std::max(0.0, pad - hb - gap);  // lift of the body over the ground plane z = 0
+  const double z_skin = base + hb + gap, z_core = z_skin + t, z_top = z_core + c.core_gap, z_upper = z_top + t;
   a.foot_z = z_skin - pad;
-  a.scale = std::max({c.width, c.length, z_upper + hb});
+  a.scale = std::max({c.width, c.length, z_upper + gap + hb});
   if (pad > 0) {
     a.pieces.push_back({axis_box(0, c.width, 0, c.foot_length, a.foot_z, z_skin), "foot"});
     a.pieces.push_back({axis_box(0, c.width, c.length - c.foot_length, c.length, a.foot_z, z_skin), "foot"});
@@ -357,8 +367,12 @@ Mesh build_robot_physical(const ParamSet& params) {
   const double y0 = c.foot_length, y1 = c.length - c.foot_length, we = end_walls ? w : 0.0;
   for (int k = 1; k <= kBladders; ++k) {
     const auto [x0, x1] = column_x(bladder_column(k), c.width, c.bladder_width);
-    const double z0 = k <= 4 ? z_upper : base, z1 = z0 + hb;
+    const double z0 = k <= 4 ? z_upper + gap : base, z1 = z0 + hb;
     const std::string name = bladder_name(k);
+    if (strip) {  // the bond strip between the chamber and the skin
+      const double xm = 0.5 * (x0 + x1), zb = k <= 4 ? z_upper : z1;
+      a.pieces.push_back({axis_box(xm - 0.5 * bond, xm + 0.5 * bond, y0, y1, zb, zb + gap), name});
+    }
     a.pieces.push_back({axis_box(x0, x1, y0, y1, z0, z0 + w), name});
     a.pieces.push_back({axis_box(x0, x1, y0, y1, z1 - w, z1), name});
     a.pieces.push_back({axis_box(x0, x0 + w, y0, y1, z0 + w, z1 - w), name});

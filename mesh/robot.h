@@ -43,6 +43,10 @@
 //   `foot`, standing in for the foot balloon in its lamina; its bottom face is the foot.
 //   A pad thicker than bladder_thickness lifts the body: the robot stands on its feet
 //   with the pads' bottoms at z = 0, as in a pull test).
+//   bladder_bond_width (default bladder_width: each chamber bonded to the skin over its
+//   full width; less: bonded along a central DS30 strip that wide, the chamber standing
+//   bladder_gap (default bladder_wall) off the skin, so that its floor is free on
+//   either side of the strip and the chamber unfolds like a flattened tube),
 //   fabric: solid (default: the volume `fabric`) or membrane (no fabric volume: each skin
 //   layer is DS10 throughout, split at its mid-thickness by an internal surface
 //   `fabric_sheet` for a membrane term, fem/membrane.h; fabric_thickness is then unused).

@@ -376,6 +376,59 @@ TEST(RobotGeometry, PhysicalSliceWithOpenChambers) {
                InputError);
 }
 
+// bladder_bond_width: each chamber bonded to the skin only along a central DS30 strip,
+// standing bladder_gap off the skin. In a slice: the DS30 volume gains the strip, the
+// chambers keep their cavities, the top chambers rise by the gap and the bottom ones
+// stay on the ground, the skin is lifted by the gap, and the gap's faces are outside
+// faces (the boundary still closes around every solid).
+TEST(RobotGeometry, PhysicalChambersBondedAlongAStrip) {
+  const double L = 0.006, t = 0.003, g = 0.001, hb = 0.003, w = 0.0008, bw = 0.02;
+  const double bond = 0.006, gap = 0.0005;
+  const std::vector<std::pair<std::string, double>> slice = {
+      {"mesh_size", 0.003}, {"length", L}, {"end_seal", 0.0}, {"foot_length", 0.0}, {"bladder_end_walls", 0}};
+  auto with = [&](std::vector<std::pair<std::string, double>> extra) {
+    auto p = slice;
+    p.insert(p.end(), extra.begin(), extra.end());
+    return robot_params("robot_physical", p);
+  };
+  const Mesh mesh = build_geometry(with({{"bladder_bond_width", bond}, {"bladder_gap", gap}}));
+  const double bladder = (bw * hb - (bw - 2 * w) * (hb - 2 * w) + bond * gap) * L;
+  double lowest_skin = 1.0;
+  for (int c : mesh.cells_of("skin"))
+    for (int i = 0; i < 4; ++i) lowest_skin = std::min(lowest_skin, node(mesh, mesh.cells(c, i)).z());
+  EXPECT_NEAR(lowest_skin, hb + gap, 1e-12);
+  const double z_upper = hb + gap + 2 * t + g;
+  for (int k = 1; k <= 8; ++k) {
+    const std::string name = "bladder_" + std::to_string(k);
+    EXPECT_NEAR(region_volume(mesh, name), bladder, 1e-10 * bladder) << k;
+    EXPECT_NEAR(area(mesh, name + "_wall"), 2 * ((bw - 2 * w) + (hb - 2 * w)) * L, 1e-12) << k;
+    double z_min = 1.0;
+    for (int c : mesh.cells_of(name))
+      for (int i = 0; i < 4; ++i) z_min = std::min(z_min, node(mesh, mesh.cells(c, i)).z());
+    EXPECT_NEAR(z_min, k <= 4 ? z_upper : 0.0, 1e-12) << k;  // a top chamber's strip starts on the skin
+  }
+  // The boundary still closes around every solid, the strips included.
+  std::vector<std::string> boundary = bladder_names("_wall");
+  for (const char* name : {"core_wall", "bottom", "outer"}) boundary.push_back(name);
+  double solid = 0.0;
+  for (const std::string& v : mesh.region_names(3)) solid += region_volume(mesh, v);
+  const auto [all, residual] = enclosed_volume(mesh, boundary);
+  EXPECT_NEAR(all, -solid, 1e-10 * solid);
+  EXPECT_LT(residual, 1e-14);
+  // New outside faces per chamber against the bonded body: the floor's underside and the
+  // skin beside the strip (bw - bond wide each), the strip's two sides (gap high), and
+  // the strip's ends at y = 0 and y = L.
+  const Mesh bonded = build_geometry(with({}));
+  const double added = 8 * ((2 * (bw - bond) + 2 * gap) * L + 2 * bond * gap);
+  EXPECT_NEAR(area(mesh, "bottom") + area(mesh, "outer") - area(bonded, "bottom") - area(bonded, "outer"), added,
+              1e-12);
+  for (auto bad :
+       std::vector<std::vector<std::pair<std::string, double>>>{{{"bladder_bond_width", 0.03}},
+                                                                {{"bladder_gap", 0.001}},
+                                                                {{"bladder_bond_width", 0.01}, {"bladder_gap", 0.0}}})
+    EXPECT_THROW(build_geometry(with(bad)), InputError);
+}
+
 // foot_pad: a DS10 pad under the skin in each foot band (volume `foot`) whose bottom
 // is the foot. A pad 1 mm thicker than the lower bladders lifts the body by 1 mm: the
 // feet are the lowest faces (z = 0), the lower bladders' bottoms 1 mm above the ground.
