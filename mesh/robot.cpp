@@ -56,6 +56,9 @@ struct Assembly {
   double foot_z = 0.0;                    // z of the skin's bottom face (the feet plane)
   double scale = 0.0;                     // largest body dimension (for tolerances)
   std::vector<double> sheet_z;            // z of internal planes named fabric_sheet (membranes)
+  // Air gaps (chambers bonded along a strip): the outside faces whose centroids lie in
+  // a box are also named after it, for self-contact across the gap.
+  std::vector<Cavity> gaps;
 };
 
 // Representative point (centroid of the first triangle) and node box of a meshed surface.
@@ -95,6 +98,36 @@ bool inside_solid(const Assembly& assembly, const Vec3& p) {
 void add_group(int dim, const std::vector<int>& tags, const std::string& name) {
   if (tags.empty()) throw std::logic_error("robot geometry: empty region " + name);
   gmsh::model::setPhysicalName(dim, gmsh::model::addPhysicalGroup(dim, tags), name);
+}
+
+// Adds a surface region per gap: copies of the outside faces (bottom, outer) whose
+// vertex centroids lie in its box. A face then belongs to both regions, as the feet do.
+void name_gap_faces(Mesh& mesh, const std::vector<Cavity>& gaps, double tol) {
+  const std::vector<int> outside = [&] {
+    std::vector<int> f = mesh.faces_of("bottom"), o = mesh.faces_of("outer");
+    f.insert(f.end(), o.begin(), o.end());
+    return f;
+  }();
+  int next_id = 0;
+  for (const Region& r : mesh.regions) next_id = std::max(next_id, r.id + 1);
+  std::vector<int> rows, ids;
+  for (const Cavity& gap : gaps) {
+    const int id = next_id++;
+    mesh.regions.push_back(Region{gap.surface, 2, id});
+    for (int f : outside) {
+      const Vec3 c = (mesh.X.row(mesh.faces(f, 0)) + mesh.X.row(mesh.faces(f, 1)) + mesh.X.row(mesh.faces(f, 2))) / 3.0;
+      if (gap.box.contains(c, tol)) {
+        rows.push_back(f);
+        ids.push_back(id);
+      }
+    }
+  }
+  const int n = mesh.n_faces();
+  mesh.faces.conservativeResize(n + static_cast<int>(rows.size()), Eigen::NoChange);
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    mesh.faces.row(n + static_cast<int>(i)) = mesh.faces.row(rows[i]);
+    mesh.face_region.push_back(ids[i]);
+  }
 }
 
 Mesh mesh_assembly(const Assembly& assembly, double mesh_size, int order, const std::string& source) {
@@ -185,7 +218,9 @@ Mesh mesh_assembly(const Assembly& assembly, double mesh_size, int order, const 
   if (!assembly.sheet_z.empty()) surface_order.push_back("fabric_sheet");
   for (const std::string& name : surface_order) add_group(2, surface_tags[name], name);
 
-  return mesh_from_current_gmsh_model(source);
+  Mesh mesh = mesh_from_current_gmsh_model(source);
+  if (!assembly.gaps.empty()) name_gap_faces(mesh, assembly.gaps, tol);
+  return mesh;
 }
 
 // Reads a length with a default, in (0, inf).
@@ -372,6 +407,10 @@ Mesh build_robot_physical(const ParamSet& params) {
     if (strip) {  // the bond strip between the chamber and the skin
       const double xm = 0.5 * (x0 + x1), zb = k <= 4 ? z_upper : z1;
       a.pieces.push_back({axis_box(xm - 0.5 * bond, xm + 0.5 * bond, y0, y1, zb, zb + gap), name});
+      // The gap's faces: the floor's underside, the strip's sides and the skin under the
+      // chamber (a quarter chamber width either side: skin triangles straddle its edges).
+      const double margin = 0.25 * c.bladder_width;
+      a.gaps.push_back({axis_box(x0 - margin, x1 + margin, y0, y1, zb, zb + gap), name + "_gap"});
     }
     a.pieces.push_back({axis_box(x0, x1, y0, y1, z0, z0 + w), name});
     a.pieces.push_back({axis_box(x0, x1, y0, y1, z1 - w, z1), name});

@@ -46,7 +46,8 @@
 //   bladder_bond_width (default bladder_width: each chamber bonded to the skin over its
 //   full width; less: bonded along a central DS30 strip that wide, the chamber standing
 //   bladder_gap (default bladder_wall) off the skin, so that its floor is free on
-//   either side of the strip and the chamber unfolds like a flattened tube),
+//   either side of the strip and the chamber unfolds like a flattened tube; surfaces
+//   bladder_1_gap .. bladder_8_gap name the outside faces in each gap, for self-contact),
 //   fabric: solid (default: the volume `fabric`) or membrane (no fabric volume: each skin
 //   layer is DS10 throughout, split at its mid-thickness by an internal surface
 //   `fabric_sheet` for a membrane term, fem/membrane.h; fabric_thickness is then unused).
