@@ -294,7 +294,7 @@ ScopedGmshModel::ScopedGmshModel(const std::string& name) {
 
 ScopedGmshModel::~ScopedGmshModel() { gmsh::model::remove(); }
 
-void generate_tet_mesh(double mesh_size, int order, const std::string& where) {
+void generate_tet_mesh(double mesh_size, int order, const std::string& where, const std::vector<VolumeSize>& refine) {
   gmsh::option::setNumber("Mesh.MeshSizeMin", 0.0);
   gmsh::option::setNumber("Mesh.MeshSizeMax", mesh_size);
   gmsh::option::setNumber("Mesh.MeshSizeFromCurvature", 0);
@@ -305,6 +305,15 @@ void generate_tet_mesh(double mesh_size, int order, const std::string& where) {
   gmsh::vectorpair points;
   gmsh::model::getEntities(points, 0);
   gmsh::model::mesh::setSize(points, mesh_size);
+  for (const VolumeSize& r : refine) {
+    gmsh::vectorpair volumes, boundary_points;
+    for (int tag : r.volumes) volumes.emplace_back(3, tag);
+    gmsh::model::getBoundary(volumes, boundary_points, false, false, true);
+    gmsh::vectorpair corner_points;
+    for (const auto& p : boundary_points)
+      if (p.first == 0) corner_points.push_back(p);
+    gmsh::model::mesh::setSize(corner_points, r.size);
+  }
   // gmsh 4.8 throws std::string from inside its 3-D mesher for some sizes on thin
   // layers (e.g. "Could not recover boundary mesh: error 2" for the physical laminate
   // with foot pads at 7.5 mm).

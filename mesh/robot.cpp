@@ -59,6 +59,7 @@ struct Assembly {
   // Air gaps (chambers bonded along a strip): the outside faces whose centroids lie in
   // a box are also named after it, for self-contact across the gap.
   std::vector<Cavity> gaps;
+  double chamber_size = 0.0;  // > 0: mesh size [m] at the bladders' corners (local refinement)
 };
 
 // Representative point (centroid of the first triangle) and node box of a meshed surface.
@@ -143,8 +144,6 @@ Mesh mesh_assembly(const Assembly& assembly, double mesh_size, int order, const 
   std::vector<gmsh::vectorpair> unused_map;
   occ::fragment({boxes.front()}, gmsh::vectorpair(boxes.begin() + 1, boxes.end()), fragments, unused_map);
   occ::synchronize();
-  generate_tet_mesh(mesh_size, order, source);
-
   const double tol = 1e-9 * assembly.scale, probe = 1e-6 * assembly.scale;
 
   // Volumes: the piece containing each fragment's centre of mass gives its region.
@@ -161,6 +160,13 @@ Mesh mesh_assembly(const Assembly& assembly, double mesh_size, int order, const 
     volume_tags[piece->region].push_back(tag);
     region_of_volume[tag] = piece->region;
   }
+  std::vector<VolumeSize> refine;
+  if (assembly.chamber_size > 0) {
+    refine.push_back({{}, assembly.chamber_size});
+    for (const auto& [tag, region] : region_of_volume)
+      if (region.rfind("bladder_", 0) == 0) refine.back().volumes.push_back(tag);
+  }
+  generate_tet_mesh(mesh_size, order, source, refine);
   for (const std::string& name : assembly.volume_order) add_group(3, volume_tags[name], name);
 
   // Boundary surfaces (one adjacent volume).
@@ -334,9 +340,26 @@ Mesh build_robot_voxel(const ParamSet& params) {
 }
 
 Mesh build_robot_physical(const ParamSet& params) {
-  params.allow_only({"type", "mesh_size", "order", "width", "length", "skin_thickness", "fabric_thickness", "core_gap",
-                     "edge_width", "end_seal", "bladder_thickness", "bladder_wall", "bladder_width", "foot_length",
-                     "bladder_end_walls", "foot_pad", "fabric", "bladder_bond_width", "bladder_gap"});
+  params.allow_only({"type",
+                     "mesh_size",
+                     "order",
+                     "width",
+                     "length",
+                     "skin_thickness",
+                     "fabric_thickness",
+                     "core_gap",
+                     "edge_width",
+                     "end_seal",
+                     "bladder_thickness",
+                     "bladder_wall",
+                     "bladder_width",
+                     "foot_length",
+                     "bladder_end_walls",
+                     "foot_pad",
+                     "fabric",
+                     "bladder_bond_width",
+                     "bladder_gap",
+                     "bladder_mesh_size"});
   const CommonRobot c = common_robot(params, 0.10, 0.15, 0.001, 0.005, 0.005, 0.003, 0.02, 0.02);
   // 0: chambers open at both ends (no end walls), e.g. for a plane-strain slice in which
   // the chambers run through the whole slice (foot_length 0) as open sleeves.
@@ -377,6 +400,10 @@ Mesh build_robot_physical(const ParamSet& params) {
   a.length = c.length;
   a.foot_length = c.foot_length;
   a.volume_order = volume_order(!sheet);
+  // Local refinement of the chambers: their walls bend, the skin around them mostly
+  // stretches, so a finer mesh there resolves the bulge at a fraction of the dofs.
+  a.chamber_size = params.number_in("bladder_mesh_size", 1e-9, c.mesh_size, c.mesh_size);
+  if (a.chamber_size >= c.mesh_size) a.chamber_size = 0.0;
   if (pad > 0) a.volume_order.push_back("foot");
   const double hb = c.bladder_thickness, ds = 0.5 * (t - tf);
   const double base = std::max(0.0, pad - hb - gap);  // lift of the body over the ground plane z = 0

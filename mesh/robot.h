@@ -48,6 +48,8 @@
 //   bladder_gap (default bladder_wall) off the skin, so that its floor is free on
 //   either side of the strip and the chamber unfolds like a flattened tube; surfaces
 //   bladder_1_gap .. bladder_8_gap name the outside faces in each gap, for self-contact),
+//   bladder_mesh_size (default mesh_size; smaller: the mesh size at the chambers'
+//   corners, graded to mesh_size away from them),
 //   fabric: solid (default: the volume `fabric`) or membrane (no fabric volume: each skin
 //   layer is DS10 throughout, split at its mid-thickness by an internal surface
 //   `fabric_sheet` for a membrane term, fem/membrane.h; fabric_thickness is then unused).
