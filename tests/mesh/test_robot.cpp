@@ -429,6 +429,32 @@ TEST(RobotGeometry, PhysicalChambersBondedAlongAStrip) {
     EXPECT_THROW(build_geometry(with(bad)), InputError);
 }
 
+// bladder_mesh_size refines the chambers only: their cells get shorter edges and are
+// more, and every region keeps its exact volume.
+TEST(RobotGeometry, PhysicalChamberRefinement) {
+  auto longest_edge = [](const Mesh& mesh, const std::string& region) {
+    double longest = 0.0;
+    for (int c : mesh.cells_of(region))
+      for (int i = 0; i < 4; ++i)
+        for (int j = i + 1; j < 4; ++j)
+          longest = std::max(longest, (node(mesh, mesh.cells(c, i)) - node(mesh, mesh.cells(c, j))).norm());
+    return longest;
+  };
+  const double h = 0.03, hc = 0.01;
+  const Mesh coarse = build_geometry(robot_params("robot_physical", {{"mesh_size", h}}));
+  const Mesh fine = build_geometry(robot_params("robot_physical", {{"mesh_size", h}, {"bladder_mesh_size", hc}}));
+  for (int k = 1; k <= 8; ++k) {
+    const std::string name = "bladder_" + std::to_string(k);
+    EXPECT_GT(fine.cells_of(name).size(), 2 * coarse.cells_of(name).size()) << k;
+    EXPECT_LT(longest_edge(fine, name), 1.5 * hc) << k;
+    EXPECT_GT(longest_edge(coarse, name), 2.0 * hc) << k;
+  }
+  for (const std::string& v : coarse.region_names(3))
+    EXPECT_NEAR(region_volume(fine, v), region_volume(coarse, v), 1e-10 * region_volume(coarse, v)) << v;
+  EXPECT_THROW(build_geometry(robot_params("robot_physical", {{"mesh_size", h}, {"bladder_mesh_size", 0.05}})),
+               InputError);
+}
+
 // foot_pad: a DS10 pad under the skin in each foot band (volume `foot`) whose bottom
 // is the foot. A pad 1 mm thicker than the lower bladders lifts the body by 1 mm: the
 // feet are the lowest faces (z = 0), the lower bladders' bottoms 1 mm above the ground.
