@@ -340,26 +340,12 @@ Mesh build_robot_voxel(const ParamSet& params) {
 }
 
 Mesh build_robot_physical(const ParamSet& params) {
-  params.allow_only({"type",
-                     "mesh_size",
-                     "order",
-                     "width",
-                     "length",
-                     "skin_thickness",
-                     "fabric_thickness",
-                     "core_gap",
-                     "edge_width",
-                     "end_seal",
-                     "bladder_thickness",
-                     "bladder_wall",
-                     "bladder_width",
-                     "foot_length",
-                     "bladder_end_walls",
-                     "foot_pad",
-                     "fabric",
-                     "bladder_bond_width",
-                     "bladder_gap",
-                     "bladder_mesh_size"});
+  // (clang-format would put these 20 keys one per line)
+  // clang-format off
+  params.allow_only({"type", "mesh_size", "order", "width", "length", "skin_thickness", "fabric_thickness", "core_gap",
+                     "edge_width", "end_seal", "bladder_thickness", "bladder_wall", "bladder_width", "foot_length",
+                     "bladder_end_walls", "foot_pad", "fabric", "bladder_bond_width", "bladder_gap", "bladder_mesh_size"});
+  // clang-format on
   const CommonRobot c = common_robot(params, 0.10, 0.15, 0.001, 0.005, 0.005, 0.003, 0.02, 0.02);
   // 0: chambers open at both ends (no end walls), e.g. for a plane-strain slice in which
   // the chambers run through the whole slice (foot_length 0) as open sleeves.
