@@ -344,7 +344,8 @@ Mesh build_robot_physical(const ParamSet& params) {
   // clang-format off
   params.allow_only({"type", "mesh_size", "order", "width", "length", "skin_thickness", "fabric_thickness", "core_gap",
                      "edge_width", "end_seal", "bladder_thickness", "bladder_wall", "bladder_width", "foot_length",
-                     "bladder_end_walls", "foot_pad", "fabric", "bladder_bond_width", "bladder_gap", "bladder_mesh_size"});
+                     "bladder_end_walls", "foot_pad", "fabric", "bladder_bond_width", "bladder_gap",
+                     "bladder_mesh_size"});
   // clang-format on
   const CommonRobot c = common_robot(params, 0.10, 0.15, 0.001, 0.005, 0.005, 0.003, 0.02, 0.02);
   // 0: chambers open at both ends (no end walls), e.g. for a plane-strain slice in which
