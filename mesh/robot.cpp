@@ -104,11 +104,9 @@ void add_group(int dim, const std::vector<int>& tags, const std::string& name) {
 // Adds a surface region per gap: copies of the outside faces (bottom, outer) whose
 // vertex centroids lie in its box. A face then belongs to both regions, as the feet do.
 void name_gap_faces(Mesh& mesh, const std::vector<Cavity>& gaps, double tol) {
-  const std::vector<int> outside = [&] {
-    std::vector<int> f = mesh.faces_of("bottom"), o = mesh.faces_of("outer");
-    f.insert(f.end(), o.begin(), o.end());
-    return f;
-  }();
+  std::vector<int> outside = mesh.faces_of("bottom");
+  const std::vector<int> outer = mesh.faces_of("outer");
+  outside.insert(outside.end(), outer.begin(), outer.end());
   int next_id = 0;
   for (const Region& r : mesh.regions) next_id = std::max(next_id, r.id + 1);
   std::vector<int> rows, ids;

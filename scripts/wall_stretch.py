@@ -14,7 +14,7 @@ Dragon Skin 30, fem/material.cpp). Region ids as in chamber_bulge.py (with
 `fabric: membrane`, bladder_1..8 = 1..8; default 1).
 """
 import argparse
-import math
+import sys
 
 import h5py
 import numpy as np
@@ -68,7 +68,13 @@ def main():
     a = ap.parse_args()
     lam = 1.0 + a.fit_strain
     fit_i1 = lam * lam + 2.0 / lam - 3.0
-    with h5py.File(a.h5, "r") as f:
+    try:
+        f = h5py.File(a.h5, "r")
+    except OSError as e:
+        sys.exit(f"{a.h5}: cannot read ({e})")
+    with f:
+        if "mesh/X" not in f or "steps" not in f:
+            sys.exit(f"{a.h5}: not a morphfem result (no mesh/X or steps)")
         X = f["mesh/X"][:]
         cells = f["mesh/cells"][:]
         region = f["mesh/cell_region"][:]
@@ -79,7 +85,7 @@ def main():
             cols = [c.decode() for c in f["tables/cavities"].attrs["columns"]]
         tets = cells[region == a.region]
         if len(tets) == 0:
-            raise SystemExit(f"{a.h5}: no cells in region {a.region}")
+            sys.exit(f"{a.h5}: no cells in region {a.region}")
         print(f"region {a.region}: {len(tets)} cells; uniaxial fit to strain {a.fit_strain:g} covers I1bar-3 <= {fit_i1:.2f}")
         pcols = [i for i, c in enumerate(cols) if c.endswith("_pressure_Pa")] if cav is not None else []
         head = f"{'t [s]':>8} {'max I1-3':>9} {'p99 I1-3':>9} {'max lam':>8} {'> fit':>7}"

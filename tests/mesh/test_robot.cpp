@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "core/errors.h"
 #include "mesh/geometry.h"
@@ -22,6 +23,14 @@ ParamSet robot_params(const std::string& type, const std::vector<std::pair<std::
 }
 
 Vec3 node(const Mesh& mesh, int n) { return mesh.X.row(n).transpose(); }
+
+// Lowest z [m] of a volume region's cell vertices.
+double lowest_z(const Mesh& mesh, const std::string& region) {
+  double z = std::numeric_limits<double>::infinity();
+  for (int c : mesh.cells_of(region))
+    for (int i = 0; i < 4; ++i) z = std::min(z, node(mesh, mesh.cells(c, i)).z());
+  return z;
+}
 
 Vec3 face_area_normal(const Mesh& mesh, int f) {
   const Vec3 x0 = node(mesh, mesh.faces(f, 0));
@@ -393,19 +402,13 @@ TEST(RobotGeometry, PhysicalChambersBondedAlongAStrip) {
   };
   const Mesh mesh = build_geometry(with({{"bladder_bond_width", bond}, {"bladder_gap", gap}}));
   const double bladder = (bw * hb - (bw - 2 * w) * (hb - 2 * w) + bond * gap) * L;
-  double lowest_skin = 1.0;
-  for (int c : mesh.cells_of("skin"))
-    for (int i = 0; i < 4; ++i) lowest_skin = std::min(lowest_skin, node(mesh, mesh.cells(c, i)).z());
-  EXPECT_NEAR(lowest_skin, hb + gap, 1e-12);
+  EXPECT_NEAR(lowest_z(mesh, "skin"), hb + gap, 1e-12);
   const double z_upper = hb + gap + 2 * t + g;
   for (int k = 1; k <= 8; ++k) {
     const std::string name = "bladder_" + std::to_string(k);
     EXPECT_NEAR(region_volume(mesh, name), bladder, 1e-10 * bladder) << k;
     EXPECT_NEAR(area(mesh, name + "_wall"), 2 * ((bw - 2 * w) + (hb - 2 * w)) * L, 1e-12) << k;
-    double z_min = 1.0;
-    for (int c : mesh.cells_of(name))
-      for (int i = 0; i < 4; ++i) z_min = std::min(z_min, node(mesh, mesh.cells(c, i)).z());
-    EXPECT_NEAR(z_min, k <= 4 ? z_upper : 0.0, 1e-12) << k;  // a top chamber's strip starts on the skin
+    EXPECT_NEAR(lowest_z(mesh, name), k <= 4 ? z_upper : 0.0, 1e-12) << k;  // a top chamber's strip starts on the skin
   }
   // The boundary still closes around every solid, the strips included.
   std::vector<std::string> boundary = bladder_names("_wall");
@@ -470,10 +473,7 @@ TEST(RobotGeometry, PhysicalFootPadsCarryTheBody) {
   EXPECT_NEAR(area(mesh, "foot_b"), W * foot, 1e-12);
   EXPECT_NEAR(area(mesh, "bottom"), W * L, 1e-12);
   for (int k = 5; k <= 8; ++k) {
-    double z_min = 1.0;
-    for (int c : mesh.cells_of("bladder_" + std::to_string(k)))
-      for (int i = 0; i < 4; ++i) z_min = std::min(z_min, node(mesh, mesh.cells(c, i)).z());
-    EXPECT_NEAR(z_min, pad - hb, 1e-12) << k;
+    EXPECT_NEAR(lowest_z(mesh, "bladder_" + std::to_string(k)), pad - hb, 1e-12) << k;
   }
   double lowest = 1.0;
   for (int n = 0; n < mesh.X.rows(); ++n) lowest = std::min(lowest, mesh.X(n, 2));
