@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "actuation/cavity.h"
+#include "core/errors.h"
 #include "fem/loads.h"
 #include "fem/petsc_check.h"
 
@@ -375,5 +376,62 @@ double VolumeControlledCavityTerm::energy_of_volume(double V) const {
 }
 
 double VolumeControlledCavityTerm::energy_derivative(double V) const { return -multiplier_ + penalty_ * (V - target_); }
+
+// ---------------------------------------------------------------- checkpoints
+
+void CavityVolumeTerm::save_volumes(const std::string& prefix, StateRecord& state) const {
+  state.set_number(prefix + ".volume", volume_);
+  state.set_number(prefix + ".converged_volume", converged_volume_);
+  state.set_number(prefix + ".converged_time", converged_time_);
+}
+
+void CavityVolumeTerm::load_volumes(const std::string& prefix, const StateRecord& state) {
+  const std::string where = "checkpoint: " + prefix;
+  volume_ = state.number(prefix + ".volume", where);
+  converged_volume_ = state.number(prefix + ".converged_volume", where);
+  converged_time_ = state.number(prefix + ".converged_time", where);
+}
+
+void GasCavityTerm::save_state(Assembler&, const std::string& prefix, StateRecord& state) {
+  save_volumes(prefix, state);
+  state.set_number(prefix + ".amount", amount_);
+  state.set_number(prefix + ".flow_rate", flow_rate_);
+  state.set_number(prefix + ".step_dt", step_dt_);
+}
+
+void GasCavityTerm::load_state(Assembler&, const std::string& prefix, const StateRecord& state) {
+  const std::string where = "checkpoint: " + prefix;
+  load_volumes(prefix, state);
+  amount_ = step_amount_ = state.number(prefix + ".amount", where);
+  reservoir_ = 0.0;  // between steps (as after end_valve_step)
+  flow_rate_ = state.number(prefix + ".flow_rate", where);
+  step_dt_ = state.number(prefix + ".step_dt", where);
+}
+
+void VolumeControlledCavityTerm::save_state(Assembler&, const std::string& prefix, StateRecord& state) {
+  save_volumes(prefix, state);
+  state.set_number(prefix + ".multiplier", multiplier_);
+  state.set_number(prefix + ".penalty", penalty_);
+  state.set_number(prefix + ".converged_pressure", converged_pressure_);
+  state.integers[prefix + ".outer_updates"] = outer_updates_;
+  std::vector<double> history;
+  for (const auto& [V, p] : history_) history.insert(history.end(), {V, p});
+  state.arrays[prefix + ".history"] = history;
+}
+
+void VolumeControlledCavityTerm::load_state(Assembler&, const std::string& prefix, const StateRecord& state) {
+  const std::string where = "checkpoint: " + prefix;
+  load_volumes(prefix, state);
+  multiplier_ = state.number(prefix + ".multiplier", where);
+  penalty_ = state.number(prefix + ".penalty", where);
+  converged_pressure_ = state.number(prefix + ".converged_pressure", where);
+  outer_updates_ = static_cast<int>(state.integer(prefix + ".outer_updates", where));
+  const auto& history = state.array(prefix + ".history", where);
+  if (history.empty() || history.size() > 4 || history.size() % 2)
+    throw InputError(where, "volume history has " + std::to_string(history.size()) + " values, expected 2 or 4");
+  history_.clear();
+  for (size_t i = 0; i < history.size(); i += 2) history_.push_back({history[i], history[i + 1]});
+  has_previous_solve_ = false;
+}
 
 }  // namespace morphfem

@@ -91,6 +91,9 @@ class CavityVolumeTerm : public EnergyTerm {
   double meshed_volume(const Assembler& assembler, const std::vector<double>& u_local) const;
   double face_volume(int k, const Eigen::MatrixXd& x, Eigen::VectorXd* g, Eigen::MatrixXd* H) const;
   double model_volume_at(Assembler& assembler, Vec u) const;  // collective
+  // The volumes and time of the last converged state (for the derived terms' save_state).
+  void save_volumes(const std::string& prefix, StateRecord& state) const;
+  void load_volumes(const std::string& prefix, const StateRecord& state);
 
   const Mesh& mesh_;
   CavityWallSpec wall_;
@@ -163,6 +166,9 @@ class GasCavityTerm : public CavityVolumeTerm {
   void set_time(double t) override;
   void begin_step(Assembler& assembler, Vec u0, double t0, double t1) override;
   void end_step(Assembler& assembler, Vec u1, double t1) override;
+  // n, the last step's flow rate and the converged volume.
+  void save_state(Assembler& assembler, const std::string& prefix, StateRecord& state) override;
+  void load_state(Assembler& assembler, const std::string& prefix, const StateRecord& state) override;
 
   double energy_of_volume(double V) const override;
   double energy_derivative(double V) const override;
@@ -232,6 +238,9 @@ class VolumeControlledCavityTerm : public CavityVolumeTerm {
   void begin_step(Assembler& assembler, Vec u0, double t0, double t1) override;
   bool update_after_solve(Assembler& assembler, Vec u1) override;
   void end_step(Assembler& assembler, Vec u1, double t1) override;
+  // lambda, k, the converged pressure and the last two converged (V, p).
+  void save_state(Assembler& assembler, const std::string& prefix, StateRecord& state) override;
+  void load_state(Assembler& assembler, const std::string& prefix, const StateRecord& state) override;
 
   double energy_of_volume(double V) const override;
   double energy_derivative(double V) const override;

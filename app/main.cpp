@@ -1,6 +1,6 @@
 // morphfem: finite elements for shape-changing pneumatic soft robots.
 //
-//   morphfem run SCENE.yaml [--set KEY=VALUE]... [PETSc options]   simulate a scene
+//   morphfem run SCENE.yaml [--set KEY=VALUE]... [--resume] [PETSc options]   simulate a scene
 //   morphfem verify [--case NAME]... [--quick] [--json] [--out DIR]
 //   morphfem fit-materials [--data-dir DIR] [--max-strain S] [--json]
 //   morphfem hw emulate|play|check ...            regulators (hardware/README.md)
@@ -34,9 +34,11 @@ namespace {
 const char* kUsage =
     "usage: morphfem <command> [arguments] [PETSc options]\n"
     "commands:\n"
-    "  run SCENE.yaml [--set KEY=VALUE]...\n"
+    "  run SCENE.yaml [--set KEY=VALUE]... [--resume]\n"
     "                               simulate a scene; results to the scene's output.directory;\n"
-    "                               --set a.b.c=VALUE sets a scene key last (e.g. solver.end_time=5)\n"
+    "                               --set a.b.c=VALUE sets a scene key last (e.g. solver.end_time=5);\n"
+    "                               --resume continues an interrupted run from its last checkpoint\n"
+    "                               (or extends a finished one to a later solver.end_time)\n"
     "  verify [--case NAME]... [--hard] [--quick] [--json] [--out DIR]\n"
     "                               verification cases (patch, mms, cylinder, cantilever) with\n"
     "                               error against the reference beside wall time\n"
@@ -57,13 +59,16 @@ int cmd_run(const std::vector<std::string>& args) {
   // morphfem run SCENE.yaml [--set KEY=VALUE ...] [PETSc options (one dash)]
   std::string path;
   std::vector<std::string> assignments;
+  morphfem::RunOptions options;
   for (size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
-    if (a == "--set") {
+    if (a == "--resume") {
+      options.resume = true;
+    } else if (a == "--set") {
       if (i + 1 >= args.size()) throw morphfem::InputError("morphfem run", "--set needs KEY=VALUE");
       assignments.push_back(args[++i]);
     } else if (a.rfind("--", 0) == 0) {
-      throw morphfem::InputError("morphfem run", "unknown option '" + a + "' (run takes --set KEY=VALUE)");
+      throw morphfem::InputError("morphfem run", "unknown option '" + a + "' (run takes --set KEY=VALUE and --resume)");
     } else if (!a.empty() && a[0] != '-' && path.empty()) {
       path = a;
     }
@@ -72,8 +77,10 @@ int cmd_run(const std::vector<std::string>& args) {
   YAML::Node doc = morphfem::load_scene_yaml(path);
   for (const auto& assignment : assignments) morphfem::set_scene_key(doc, assignment, path);
   morphfem::Scene scene = morphfem::scene_from_yaml(doc, path);
-  auto result = morphfem::run_scene(scene, PETSC_COMM_WORLD);
+  options.scene_text = morphfem::scene_identity(doc);
+  auto result = morphfem::run_scene(scene, PETSC_COMM_WORLD, options);
   if (rank_of_world() == 0) {
+    if (result.resumed_at >= 0) std::printf("%s: resumed at t = %.6g s\n", scene.name.c_str(), result.resumed_at);
     std::printf("%s: %s, %ld dofs, %d steps, %d Newton iterations, %d step cuts, %.2f s", scene.name.c_str(),
                 result.stats.completed ? "completed" : "FAILED", result.dofs, result.stats.steps,
                 result.stats.newton_its, result.stats.step_cuts, result.stats.wall_s);

@@ -292,7 +292,7 @@ SimulationResult run_robot_case(const RobotCase& c, const RobotFidelity& level, 
   const YAML::Node doc = robot_scene_yaml(c, level, output_dir);
   // Messages name the template; relative paths in it stay relative to it.
   Scene scene = scene_from_yaml(doc, c.template_scene);
-  SimulationResult r = run_scene(scene, comm, RunOptions{!output_dir.empty(), progress, {}});
+  SimulationResult r = run_scene(scene, comm, RunOptions{!output_dir.empty(), progress});
   int rank = 0;
   MPI_Comm_rank(comm, &rank);
   if (rank == 0 && !r.output_dir.empty()) {

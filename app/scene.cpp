@@ -674,7 +674,7 @@ Scene scene_from_yaml(const YAML::Node& root, const std::string& path) {
                      "implicit-Euler slip u - u_n; with bdf2/newmark it would be inconsistent)");
 
   if (const auto o = root["output"]) {
-    r.allow(o, "output", {"directory", "every"});
+    r.allow(o, "output", {"directory", "every", "checkpoint_s"});
     if (o["directory"]) {
       std::filesystem::path dir = r.text(o["directory"], "output.directory");
       scene.output_dir = dir.string();
@@ -683,6 +683,10 @@ Scene scene_from_yaml(const YAML::Node& root, const std::string& path) {
       double every = r.number(o["every"], "output.every");
       if (every < 1 || every != int(every)) r.fail(o["every"], "output.every", "must be a positive integer");
       scene.output_every = int(every);
+    }
+    if (o["checkpoint_s"]) {
+      scene.checkpoint_s = r.number(o["checkpoint_s"], "output.checkpoint_s");
+      if (!(scene.checkpoint_s >= 0)) r.fail(o["checkpoint_s"], "output.checkpoint_s", "must be >= 0 [s]");
     }
   }
   return scene;

@@ -88,7 +88,10 @@
 //     # g = |g| (-sin s cos h, -sin s sin h, -cos s): uphill is the heading (cos h, sin h, 0).
 //     # With an actuation schedule the run reports the gait: displacement of the mean
 //     # node position along the heading from `start` to the end of the gait, in BL/s.
-//   output: {directory: results/demo, every: 1}
+//   output: {directory: results/demo, every: 1,  # every: write each n-th step
+//            checkpoint_s: 600}                 # wall seconds between checkpoints (0: only
+//     # the final one); `morphfem run SCENE --resume` continues an interrupted run from
+//     # its last checkpoint, or extends a finished one to a later solver.end_time.
 #pragma once
 #include <yaml-cpp/yaml.h>
 
@@ -184,6 +187,7 @@ struct Scene {
   int quadrature_degree = 0;
   std::string output_dir;  // empty: no files
   int output_every = 1;
+  double checkpoint_s = 600.0;  // wall seconds between checkpoints (0: only the final one)
 };
 
 // Reads and checks a scene file. Throws InputError("file:line:col", what) on the

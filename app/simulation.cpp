@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <limits>
 #include <map>
+#include <sstream>
 #include <stdexcept>
 
 #include "actuation/cavity.h"
@@ -21,6 +22,7 @@
 #include "core/errors.h"
 #include "core/json.h"
 #include "core/progress.h"
+#include "core/state_file.h"
 #include "fem/damping.h"
 #include "fem/elastic.h"
 #include "fem/inertia.h"
@@ -109,7 +111,43 @@ void require_surface(const Scene& scene, const Mesh& mesh, const std::string& na
   }
 }
 
+// Thrown by the step callback to stop a run as a kill would (RunOptions::stop_after_steps).
+struct StopRun {};
+
+// The directory whose checkpoint a resumed run continues from: the interrupted
+// run's partial output, else a finished run's output. Rank 0 only.
+std::string checkpoint_to_resume(const Scene& scene) {
+  namespace fs = std::filesystem;
+  const std::string partial = scene.output_dir + ".partial";
+  if (fs::exists(partial + "/checkpoint.h5")) return partial;
+  if (fs::exists(scene.output_dir + "/checkpoint.h5")) return scene.output_dir;
+  throw InputError("--resume", "no checkpoint in " + partial + "/ (an interrupted run) or " + scene.output_dir +
+                                   "/ (a finished one); run without --resume first");
+}
+
+// First line where two texts differ (for "the scene differs from the checkpoint's").
+std::string first_difference(const std::string& a, const std::string& b) {
+  std::istringstream sa(a), sb(b);
+  std::string la, lb;
+  for (int line = 1;; ++line) {
+    const bool ga = static_cast<bool>(std::getline(sa, la)), gb = static_cast<bool>(std::getline(sb, lb));
+    if (!ga && !gb) return "";
+    if (!ga || !gb || la != lb)
+      return "line " + std::to_string(line) + ": checkpoint '" + (ga ? la : "") + "', now '" + (gb ? lb : "") + "'";
+  }
+}
+
 }  // namespace
+
+std::string scene_identity(const YAML::Node& doc) {
+  YAML::Node copy = YAML::Clone(doc);
+  // Neither changes the steps: how far the run goes, how often it checkpoints.
+  if (copy["solver"] && copy["solver"].IsMap() && copy["solver"]["end_time"]) copy["solver"].remove("end_time");
+  if (copy["output"] && copy["output"].IsMap() && copy["output"]["checkpoint_s"]) copy["output"].remove("checkpoint_s");
+  YAML::Emitter out;
+  out << copy;
+  return out.c_str();
+}
 
 double contact_shear_modulus(const Mesh& mesh, const std::vector<std::shared_ptr<const Material>>& materials,
                              const std::vector<std::string>& surfaces) {
@@ -324,11 +362,70 @@ SimulationResult run_scene(const Scene& scene, MPI_Comm comm, const RunOptions& 
 
   // ---- Output (rank 0 writes; every rank takes part in the gathers).
   const bool write = options.write_output && !scene.output_dir.empty();
+  if (options.resume && !write)
+    throw InputError(scene_key(scene, "", "output.directory"), "--resume needs the scene's output directory");
+  // Resuming: the checkpoint, read on rank 0, checked and sent to every rank.
+  StateRecord checkpoint;
+  double wall_before = 0.0;  // wall time of the earlier parts of a resumed run [s]
+  if (options.resume) {
+    std::string error, from;
+    if (rank == 0) {
+      try {
+        from = checkpoint_to_resume(scene);
+        checkpoint = read_state_file(from + "/checkpoint.h5");
+      } catch (const InputError& e) {
+        error = e.what();
+      }
+    }
+    bcast_string(error, comm);
+    if (!error.empty()) throw InputError("", error);
+    bcast_string(from, comm);
+    broadcast_state(checkpoint, comm);
+    const std::string where = from + "/checkpoint.h5";
+    if (checkpoint.integer("run.ranks", where) != size)
+      throw InputError(where, "written by a run on " + std::to_string(checkpoint.integer("run.ranks", where)) +
+                                  " ranks; resume it with the same number (mpirun -n " +
+                                  std::to_string(checkpoint.integer("run.ranks", where)) + ")");
+    if (checkpoint.integer("run.nodes", where) != mesh.n_nodes() ||
+        checkpoint.integer("run.cells", where) != mesh.n_cells())
+      throw InputError(where, "its mesh has " + std::to_string(checkpoint.integer("run.nodes", where)) + " nodes and " +
+                                  std::to_string(checkpoint.integer("run.cells", where)) + " cells, this scene's " +
+                                  std::to_string(mesh.n_nodes()) + " and " + std::to_string(mesh.n_cells()));
+    const std::string diff = first_difference(checkpoint.text("run.scene", where), options.scene_text);
+    if (!diff.empty())
+      throw InputError(
+          where,
+          "the scene differs from the checkpoint's (only solver.end_time and output.checkpoint_s may change): " + diff);
+    const double t_saved = checkpoint.number("solver.t", where);
+    if (!(t_saved < t_end - 1e-12 * std::max(1.0, t_end)))
+      throw InputError(where, "the checkpoint is at t = " + std::to_string(t_saved) +
+                                  " s; set a later solver.end_time (now " + std::to_string(t_end) + " s) to extend it");
+    result.stats = solver.load_state(checkpoint, where);
+    result.resumed_at = t_saved;
+    wall_before = checkpoint.number("run.wall_s", where);
+    // Extending a finished run: its output is copied to the partial directory, which
+    // replaces it when this run ends (the finished results stay until then).
+    if (rank == 0 && from == scene.output_dir) {
+      namespace fs = std::filesystem;
+      const std::string partial = scene.output_dir + ".partial";
+      std::error_code ec;
+      fs::remove_all(partial, ec);
+      fs::copy(from, partial, fs::copy_options::recursive, ec);
+      if (ec) error = "cannot copy " + from + " to " + partial + ": " + ec.message();
+    }
+    bcast_string(error, comm);
+    if (!error.empty()) throw InputError("--resume", error);
+  }
   std::string tmp_dir;
   std::unique_ptr<ResultWriter> writer;
   if (write && rank == 0) {
-    tmp_dir = temporary_output_dir(scene.output_dir);
-    writer = std::make_unique<ResultWriter>(tmp_dir, scene.name, mesh);
+    if (options.resume) {
+      tmp_dir = scene.output_dir + ".partial";
+      writer = std::make_unique<ResultWriter>(tmp_dir, scene.name, mesh, result.resumed_at);
+    } else {
+      tmp_dir = temporary_output_dir(scene.output_dir);
+      writer = std::make_unique<ResultWriter>(tmp_dir, scene.name, mesh);
+    }
   }
   std::vector<std::string> cavity_columns{"time"};
   for (const auto& c : cavities) {
@@ -461,18 +558,83 @@ SimulationResult run_scene(const Scene& scene, MPI_Comm comm, const RunOptions& 
     if (options.on_step) options.on_step(t, mesh, result.u, result);
   };
 
-  Progress progress(scene.name, t_end, options.progress);
-  record(0.0, true, 0);
+  // Checkpoints: the solver and its terms (QuasiStaticSolver::save_state) and what
+  // this loop accumulates. Collective; rank 0 writes.
   int last_written = 0;
-  result.stats = solver.run([&](const StepReport& r) {
-    const bool last = r.t >= t_end - 1e-12 * t_end;
-    record(r.t, last, r.step);
-    if (last || r.step % scene.output_every == 0) last_written = r.step;
-    progress.update(r.t, "step " + std::to_string(r.step) + " newton " + std::to_string(r.newton_its));
-  });
+  const auto save_checkpoint = [&](const std::string& dir) {
+    StateRecord state;
+    solver.save_state(state);
+    if (rank != 0) return;
+    state.integers["run.ranks"] = size;
+    state.integers["run.nodes"] = mesh.n_nodes();
+    state.integers["run.cells"] = mesh.n_cells();
+    state.integers["run.last_written"] = last_written;
+    state.texts["run.scene"] = options.scene_text;
+    state.set_number("run.wall_s",
+                     wall_before + std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    state.set_number("run.friction_dissipated", friction_dissipated);
+    state.set_number("run.heading_at_start", heading_at_start);
+    state.integers["run.gait_complete"] = result.gait_complete;
+    state.set_number("run.gait_displacement_m", result.gait_displacement_m);
+    state.set_number("run.speed_bl_per_s", result.speed_bl_per_s);
+    std::vector<double> path;
+    for (const auto& p : result.trajectory) path.insert(path.end(), p.begin(), p.end());
+    state.arrays["run.trajectory"] = path;
+    write_state_file(dir + "/checkpoint.h5", state);
+  };
+  if (options.resume) {
+    const std::string where = "checkpoint";
+    last_written = static_cast<int>(checkpoint.integer("run.last_written", where));
+    friction_dissipated = checkpoint.number("run.friction_dissipated", where);
+    heading_at_start = checkpoint.number("run.heading_at_start", where);
+    result.gait_complete = checkpoint.integer("run.gait_complete", where) != 0;
+    result.gait_displacement_m = checkpoint.number("run.gait_displacement_m", where);
+    result.speed_bl_per_s = checkpoint.number("run.speed_bl_per_s", where);
+    const auto& path = checkpoint.array("run.trajectory", where);
+    for (size_t i = 0; i + 3 < path.size(); i += 4)
+      result.trajectory.push_back({path[i], path[i + 1], path[i + 2], path[i + 3]});
+  }
+
+  Progress progress(scene.name, t_end, options.progress);
+  if (options.resume) {
+    progress.set_resumed_from(result.resumed_at);
+  } else {
+    record(0.0, true, 0);
+  }
+  auto last_checkpoint = std::chrono::steady_clock::now();
+  int steps_here = 0;
+  try {
+    result.stats = solver.run([&](const StepReport& r) {
+      const bool last = r.t >= t_end - 1e-12 * t_end;
+      record(r.t, last, r.step);
+      if (last || r.step % scene.output_every == 0) last_written = r.step;
+      progress.update(r.t, "step " + std::to_string(r.step) + " newton " + std::to_string(r.newton_its));
+      ++steps_here;
+      const bool stop = options.stop_after_steps > 0 && steps_here == options.stop_after_steps;
+      // Rank 0's clock decides, so every rank takes part in the same checkpoints.
+      int due = write && !last && scene.checkpoint_s > 0 &&
+                std::chrono::duration<double>(std::chrono::steady_clock::now() - last_checkpoint).count() >=
+                    scene.checkpoint_s;
+      MPI_Bcast(&due, 1, MPI_INT, 0, comm);
+      if (write && (due || stop)) {
+        save_checkpoint(tmp_dir);
+        last_checkpoint = std::chrono::steady_clock::now();
+      }
+      if (stop) throw StopRun{};
+    });
+  } catch (const StopRun&) {
+    progress.finish("stopped");
+    result.stopped = true;
+    result.stats = RunStats{};
+    result.stats.failure = "stopped after " + std::to_string(steps_here) + " steps (checkpoint in " + tmp_dir + ")";
+    result.stats.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (writer) writer->close();
+    return result;
+  }
   if (!result.stats.completed && last_written != result.stats.steps) record(solver.time(), true, result.stats.steps);
   progress.finish(result.stats.completed ? "done" : "FAILED");
-  result.stats.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (write) save_checkpoint(tmp_dir);  // the final state: a later run may extend it (--resume)
+  result.stats.wall_s = wall_before + std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
   if (write) {
     if (rank == 0) {
@@ -492,6 +654,7 @@ SimulationResult run_scene(const Scene& scene, MPI_Comm comm, const RunOptions& 
           .add("linear_its", result.stats.linear_its)
           .add("step_cuts", result.stats.step_cuts)
           .add("wall_s", result.stats.wall_s)
+          .add("resumed_at_s", result.resumed_at)
           .add("min_J", result.min_J)
           .add("mass_kg", result.mass_kg)
           .add("max_displacement_m", result.u.rowwise().norm().maxCoeff());

@@ -31,15 +31,34 @@ struct SimulationResult {
   std::vector<std::array<double, 4>> trajectory;
   bool gait_complete = false;
   double gait_displacement_m = 0, speed_bl_per_s = 0;
+  bool stopped = false;    // stopped by RunOptions::stop_after_steps (output left in OUTPUT.partial)
+  double resumed_at = -1;  // time of the checkpoint this run resumed from [s] (-1: not resumed)
 };
 
 struct RunOptions {
+  RunOptions(bool write_output = true, bool progress = true) : write_output(write_output), progress(progress) {}
   bool write_output = true;  // honour scene.output_dir
   bool progress = true;      // progress line with ETA on stderr (rank 0)
   // Optional hook after each converged step (e.g. a verification case sampling a
   // quantity along the load path): time, displacement (all nodes), cavity data.
   std::function<void(double t, const Mesh&, const RowMatrixXd& u, const SimulationResult&)> on_step;
+  // Checkpoints (scene key output.checkpoint_s): the run's whole state goes to
+  // OUTPUT.partial/checkpoint.h5 every checkpoint_s of wall time and, at the end, to
+  // OUTPUT/checkpoint.h5. resume = true continues from the checkpoint of an
+  // interrupted run (OUTPUT.partial) or extends a finished one (OUTPUT, to a later
+  // solver.end_time) as if it had never stopped: same steps, same results.
+  // scene_text identifies the scene (scene_identity() of its document); a
+  // checkpoint of another scene is refused.
+  bool resume = false;
+  std::string scene_text;
+  // Test hook: after this many steps of this process, save a checkpoint and stop
+  // as a killed run would (the output stays in OUTPUT.partial); 0: no stop.
+  int stop_after_steps = 0;
 };
+
+// The scene document as checkpoints identify it: every key but solver.end_time and
+// output.checkpoint_s.
+std::string scene_identity(const YAML::Node& doc);
 
 // Shear modulus [Pa] of the material under most of the surfaces' area (each
 // boundary face takes the material of the cell it bounds; 0 if none). The

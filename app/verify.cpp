@@ -149,7 +149,7 @@ void patch_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<Verificatio
       prescribe_on_block_faces(s, [G](const Eigen::Vector3d& X, double t) { return Eigen::Vector3d(t * G * X); });
       s.solver.t_end = 1.0;
       s.solver.dt_initial = 0.5;
-      auto r = run_scene(s, comm, {false, opt.progress, {}});
+      auto r = run_scene(s, comm, {false, opt.progress});
       require_completed(r, "patch test");
       double err_u = 0, scale_u = 0, err_F = 0;
       for (int n = 0; n < r.mesh.n_nodes(); ++n) {
@@ -223,7 +223,7 @@ void mms_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<VerificationR
       s.body_force_degree = 6;
       s.solver.t_end = 1.0;
       s.solver.dt_initial = 0.5;
-      auto r = run_scene(s, comm, {false, opt.progress, {}});
+      auto r = run_scene(s, comm, {false, opt.progress});
       require_completed(r, "manufactured solution");
       // Errors by degree-6 quadrature: ||u_h - u||_L2 / ||u||_L2, |u_h - u|_H1 / |u|_H1.
       double e_L2 = 0, n_L2 = 0, e_H1 = 0, n_H1 = 0;
@@ -308,7 +308,7 @@ void cylinder_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<Verifica
     s.solver.t_end = 1.0;
     s.solver.dt_initial = 0.1;
     s.solver.dt_max = 0.25;
-    auto r = run_scene(s, comm, {false, opt.progress, {}});
+    auto r = run_scene(s, comm, {false, opt.progress});
     require_completed(r, "thick cylinder");
     // Inner stretch from the inner wall's vertices: la = mean |x_xy| / A.
     std::set<int> vertices;
@@ -362,7 +362,7 @@ void cantilever_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<Verifi
       for (const auto& [k, v] : reference)
         if (k <= k_max) s.solver.output_times.push_back(k / k_max);
       std::map<int, double> deflection;
-      RunOptions run{false, opt.progress, {}};
+      RunOptions run{false, opt.progress};
       run.on_step = [&](double t, const Mesh& mesh, const RowMatrixXd& u, const SimulationResult&) {
         for (const auto& [k, v] : reference)
           if (std::abs(t - k / k_max) < 1e-9) {
@@ -422,7 +422,7 @@ void slope_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<Verificatio
   for (size_t level = 0; level < steps.size(); ++level) {
     const double dt = steps[level];
     Scene s = sliding_block_scene("slope", TimeFunction::constant(mu), 1e-4, T, dt);
-    auto r = run_scene(s, comm, {false, opt.progress, {}});
+    auto r = run_scene(s, comm, {false, opt.progress});
     require_completed(r, "block on a slope");
     double slide = 0;
     for (int n = 0; n < r.mesh.n_nodes(); ++n) slide += r.u(n, 0);
@@ -452,7 +452,7 @@ void friction_switch_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<V
     Scene s = sliding_block_scene("friction_switch", mu, 1e-5, T, dt);
     s.solver.output_times = {1.0, 2.0};
     double slide_at_1 = 0;
-    RunOptions run{false, opt.progress, {}};
+    RunOptions run{false, opt.progress};
     run.on_step = [&](double t, const Mesh& mesh, const RowMatrixXd& u, const SimulationResult&) {
       if (std::abs(t - 1.0) < 1e-9) slide_at_1 = u.col(0).mean();
     };

@@ -101,7 +101,7 @@ RollingResult run_rolling(const RollingSetup& setup, const VerifyOptions& opt, M
 
   std::vector<double> weights, times, travel;
   double weight_sum = 0;
-  RunOptions run{false, opt.progress, {}};
+  RunOptions run{false, opt.progress};
   run.on_step = [&](double t, const Mesh& mesh, const RowMatrixXd& u, const SimulationResult&) {
     if (weights.empty()) {
       weights = nodal_volume_weights(mesh);
@@ -174,7 +174,7 @@ HertzResult run_hertz(const HertzSetup& setup, const VerifyOptions& opt, MPI_Com
   scene.solver.dt_max = 0.5;
 
   HertzResult result;
-  result.run = run_scene(scene, comm, {false, opt.progress, {}});
+  result.run = run_scene(scene, comm, {false, opt.progress});
   require_completed(result.run, "Hertz contact");
   const Mesh& mesh = result.run.mesh;
   const std::vector<double> area = nodal_area_weights(mesh, mesh.faces_of("sphere"));

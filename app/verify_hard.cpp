@@ -140,7 +140,7 @@ CookResult run_cook(int divisions, int order, const std::string& formulation, do
   s.solver.t_end = 1.0;
   s.solver.dt_initial = 0.25;
   s.solver.dt_max = 0.5;
-  CookResult out{0.0, run_scene(s, comm, {false, progress, {}})};
+  CookResult out{0.0, run_scene(s, comm, {false, progress})};
   require_completed(out.run, "cook membrane (" + formulation_label(order, formulation) + ", " +
                                  std::to_string(divisions) + " divisions)");
   out.tip_mm = 1e3 * mean_displacement_on_z_line(out.run.mesh, out.run.u, 0.048, 0.060, 1e-9, 1);
@@ -297,7 +297,7 @@ void incompressible_block_case(const VerifyOptions& opt, MPI_Comm comm, std::vec
                   fixed("zmin", false, false, true), top};
     s.solver.dt_initial = 0.05;  // kappa / mu = 5000: small load steps keep Newton in its basin
     s.solver.dt_max = 0.1;
-    auto r = run_scene(s, comm, {false, opt.progress, {}});
+    auto r = run_scene(s, comm, {false, opt.progress});
     require_completed(r, "incompressible block, uniaxial tension");
     double lateral, P33;
     uniaxial_state(*law, stretch, lateral, P33);
@@ -324,7 +324,7 @@ void incompressible_block_case(const VerifyOptions& opt, MPI_Comm comm, std::vec
       s.tractions.push_back(shear);
       s.solver.dt_initial = 0.05;
       s.solver.dt_max = 0.1;
-      auto r = run_scene(s, comm, {false, opt.progress, {}});
+      auto r = run_scene(s, comm, {false, opt.progress});
       require_completed(r, "incompressible block, shear (" + formulation + ")");
       const auto top = r.mesh.nodes_of_surface("zmax");
       double ux = 0;
@@ -377,7 +377,7 @@ void compression_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<Verif
   };
   {  // (1) frictionless
     const double h = L / 2;
-    auto r = run_scene(scene(h, false), comm, {false, opt.progress, {}});
+    auto r = run_scene(scene(h, false), comm, {false, opt.progress});
     require_completed(r, "compression, frictionless");
     double lateral, P33;
     uniaxial_state(*law, 0.5, lateral, P33);
@@ -392,7 +392,7 @@ void compression_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<Verif
   const std::vector<int> divisions = opt.quick ? std::vector<int>{2} : std::vector<int>{2, 3, 4};
   std::vector<std::pair<SimulationResult, double>> runs;
   for (size_t level = 0; level < divisions.size(); ++level) {
-    auto r = run_scene(scene(L / divisions[level], true), comm, {false, opt.progress, {}});
+    auto r = run_scene(scene(L / divisions[level], true), comm, {false, opt.progress});
     if (!r.stats.completed) {
       // Recorded, not thrown: how far the compression got (fraction of the 50 %)
       // before the solver gave up (typically a corner cell at a bonded edge folding).

@@ -252,7 +252,7 @@ TubeVacuumResult run_tube_vacuum(double h, int order, MPI_Comm comm, bool progre
   out.min_distance = out.min_J = std::numeric_limits<double>::infinity();
   out.dhat = kDhat;
   out.inflation = kInflation;
-  RunOptions run{false, progress, {}};
+  RunOptions run{false, progress};
   run.on_step = [&](double, const Mesh& mesh, const RowMatrixXd& u, const SimulationResult& r) {
     const SurfaceDistances d = brute_force_surface_distances(mesh, mesh.X + u, "cavity_top", "cavity_bottom");
     out.min_distance = std::min(out.min_distance, d.min());

@@ -598,6 +598,32 @@ bool SelfContactTerm::refresh_pieces(const RowMatrixXd& U) {
 
 void SelfContactTerm::refresh(Assembler& assembler, Vec u) { refresh(assembler.gather_all(u)); }
 
+void SelfContactTerm::save_state(Assembler& assembler, const std::string& prefix, StateRecord& state) {
+  state.integers[prefix + ".active"] = active_;
+  state.integers[prefix + ".refreshes"] = n_refreshes_;
+  if (assembler.rank() != 0) return;
+  std::vector<double> anchor(3 * anchor_.size());
+  for (size_t a = 0; a < anchor_.size(); ++a)
+    for (int i = 0; i < 3; ++i) anchor[3 * a + i] = anchor_[a][i];
+  state.arrays[prefix + ".anchor"] = std::move(anchor);
+}
+
+void SelfContactTerm::load_state(Assembler&, const std::string& prefix, const StateRecord& state) {
+  const std::string where = "checkpoint: " + prefix;
+  active_ = state.integer(prefix + ".active", where) != 0;
+  const auto& anchor = state.array(prefix + ".anchor", where, 3L * mesh_.n_nodes());
+  RowMatrixXd U(mesh_.n_nodes(), 3);
+  for (int a = 0; a < mesh_.n_nodes(); ++a)
+    for (int i = 0; i < 3; ++i) U(a, i) = anchor[3 * a + i];
+  if (active_) {
+    refresh(U);  // the candidates of the last search, from the same positions
+  } else {
+    pairs_.clear();
+    edge_pairs_.clear();
+  }
+  n_refreshes_ = static_cast<int>(state.integer(prefix + ".refreshes", where));
+}
+
 void SelfContactTerm::refresh(const RowMatrixXd& u) {
   for (int a = 0; a < mesh_.n_nodes(); ++a) anchor_[a] = u.row(a).transpose();
   build_candidates(mesh_.X + u);

@@ -118,6 +118,10 @@ class SelfContactTerm : public EnergyTerm {
   // Rebuilds the candidates at u0 once a surface node moved more than r/4 since
   // the last refresh (returns true: the solver re-creates the pattern). Collective.
   bool refresh_pieces(Assembler& assembler, Vec u0) override;
+  // Whether contact has started, and the displacement of the last candidate
+  // search (the candidates are rebuilt from it on load).
+  void save_state(Assembler& assembler, const std::string& prefix, StateRecord& state) override;
+  void load_state(Assembler& assembler, const std::string& prefix, const StateRecord& state) override;
   // The same decision from the whole displacement field (identical on every rank);
   // also switches the term on at its start time.
   bool refresh_pieces(const RowMatrixXd& u);

@@ -41,7 +41,8 @@ void Progress::update(double done, const std::string& info) {
   last_ = now;
   double elapsed = std::chrono::duration<double>(now - start_).count();
   double frac = total_ > 0 ? done / total_ : 1.0;
-  double eta = frac > 1e-9 ? elapsed * (1.0 - frac) / frac : -1.0;
+  const double rate_done = done - resumed_from_;  // work done by this process
+  double eta = total_ <= 0 ? 0.0 : rate_done > 1e-9 * total_ ? elapsed * (total_ - done) / rate_done : -1.0;
   const int width = 30;
   int filled = static_cast<int>(frac * width + 0.5);
   std::string bar(std::max(0, std::min(width, filled)), '#');

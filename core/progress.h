@@ -13,10 +13,14 @@ class Progress {
   // Report that `done` of `total` is complete; `info` is appended (e.g. "step 12").
   void update(double done, const std::string& info = "");
   void finish(const std::string& info = "");
+  // Work already done before this process started (a resumed run): the ETA then
+  // extrapolates the rate since the start of this process only.
+  void set_resumed_from(double done) { resumed_from_ = done; }
 
  private:
   std::string label_;
   double total_;
+  double resumed_from_ = 0.0;
   bool enabled_;
   bool tty_;
   std::chrono::steady_clock::time_point start_, last_;

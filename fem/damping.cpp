@@ -4,8 +4,10 @@
 
 #include <stdexcept>
 
+#include "core/errors.h"
 #include "fem/assembly.h"
 #include "fem/kinematics.h"
+#include "fem/term_state.h"
 
 namespace morphfem {
 
@@ -178,6 +180,54 @@ void DampingTerm::end_step(Assembler& assembler, Vec u1, double /*t1*/) {
   total_dissipated_ += last_dissipated_;
   h_prev_ = h_;
   ++steps_done_;
+}
+
+namespace {
+// Per piece, per point 3x3 tensors <-> one flat array (9 values per point, column-major).
+std::vector<double> flatten(const std::vector<std::vector<Mat3>>& tensors) {
+  std::vector<double> out;
+  for (const auto& piece : tensors)
+    for (const Mat3& m : piece) out.insert(out.end(), m.data(), m.data() + 9);
+  return out;
+}
+
+void unflatten(const std::vector<double>& flat, std::vector<std::vector<Mat3>>& tensors, int n_pieces, int points,
+               const std::string& where) {
+  if (flat.size() != static_cast<size_t>(n_pieces) * points * 9)
+    throw InputError(where, "damping history has " + std::to_string(flat.size()) + " values, expected " +
+                                std::to_string(static_cast<size_t>(n_pieces) * points * 9));
+  tensors.assign(n_pieces, std::vector<Mat3>(points));
+  for (int k = 0; k < n_pieces; ++k)
+    for (int q = 0; q < points; ++q)
+      tensors[k][q] = Eigen::Map<const Mat3>(&flat[(static_cast<size_t>(k) * points + q) * 9]);
+}
+}  // namespace
+
+void DampingTerm::save_state(Assembler& assembler, const std::string& prefix, StateRecord& state) {
+  state.integers[prefix + ".steps_done"] = steps_done_;
+  state.set_number(prefix + ".h_prev", h_prev_);
+  state.set_number(prefix + ".last_dissipated", last_dissipated_);
+  state.set_number(prefix + ".total_dissipated", total_dissipated_);
+  save_rank_data(assembler.comm(), flatten(Edot_n_), prefix + ".Edot_n", state);
+  save_rank_data(assembler.comm(), flatten(E_nm1_), prefix + ".E_nm1", state);
+}
+
+void DampingTerm::load_state(Assembler& assembler, const std::string& prefix, const StateRecord& state) {
+  const std::string where = "checkpoint: " + prefix;
+  steps_done_ = static_cast<int>(state.integer(prefix + ".steps_done", where));
+  h_prev_ = state.number(prefix + ".h_prev", where);
+  last_dissipated_ = state.number(prefix + ".last_dissipated", where);
+  total_dissipated_ = state.number(prefix + ".total_dissipated", where);
+  const auto edot = load_rank_data(assembler.comm(), state, prefix + ".Edot_n", where);
+  const auto e_nm1 = load_rank_data(assembler.comm(), state, prefix + ".E_nm1", where);
+  const int points = static_cast<int>(table_.points.size());
+  if (edot.empty() && e_nm1.empty()) {  // no step yet on this rank's pieces
+    Edot_n_.clear();
+    E_nm1_.clear();
+    return;
+  }
+  unflatten(edot, Edot_n_, n_pieces(), points, where);
+  unflatten(e_nm1, E_nm1_, n_pieces(), points, where);
 }
 
 }  // namespace morphfem

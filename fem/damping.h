@@ -81,6 +81,9 @@ class DampingTerm : public EnergyTerm {
   void begin_step(Assembler& assembler, Vec u0, double t0, double t1) override;
   // Advances Edot_n, E_{n-1}; adds the step's dissipated energy W. Collective.
   void end_step(Assembler& assembler, Vec u1, double t1) override;
+  // Edot_n, E_{n-1} per point (this rank's pieces), the last step length, the dissipation.
+  void save_state(Assembler& assembler, const std::string& prefix, StateRecord& state) override;
+  void load_state(Assembler& assembler, const std::string& prefix, const StateRecord& state) override;
 
   double last_dissipated() const { return last_dissipated_; }    // of the last step [J]
   double total_dissipated() const { return total_dissipated_; }  // since the start [J]

@@ -45,6 +45,13 @@ class EndMomentTerm : public EnergyTerm {
   void set_time(double t) override { moment_now_ = moment_(t); }
   void begin_step(Assembler& assembler, Vec u0, double t0, double t1) override;
   void end_step(Assembler& assembler, Vec u1, double t1) override;
+  // The branch centre (the winding of the section's rotation).
+  void save_state(Assembler&, const std::string& prefix, StateRecord& state) override {
+    state.set_number(prefix + ".branch", branch_);
+  }
+  void load_state(Assembler&, const std::string& prefix, const StateRecord& state) override {
+    branch_ = state.number(prefix + ".branch", "checkpoint: " + prefix);
+  }
 
   // Section rotation theta [rad] of a whole displacement field (n_nodes x 3), on the
   // branch of the last converged state.

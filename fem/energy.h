@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "core/state_file.h"
+
 namespace morphfem {
 
 // Nodal data of one piece, n nodes: reference coordinates X and displacement u
@@ -83,6 +85,16 @@ class EnergyTerm {
   };
   virtual bool has_low_rank() const { return false; }
   virtual void low_rank(class Assembler& /*assembler*/, Vec /*u*/, std::vector<LowRank>& /*out*/) {}
+
+  // Checkpoints (morphfem run --resume): a term with history between steps
+  // (velocities, strain rates, gas amounts, multipliers, contact candidates) saves
+  // it under keys that start with `prefix` and loads it back exactly, so a resumed
+  // run continues as if it had never stopped. Called between steps only. Collective;
+  // `state` is complete on rank 0 after save_state and on every rank for load_state
+  // (fem/term_state.h has the helpers). Default: no history.
+  virtual void save_state(class Assembler& /*assembler*/, const std::string& /*prefix*/, StateRecord& /*state*/) {}
+  virtual void load_state(class Assembler& /*assembler*/, const std::string& /*prefix*/, const StateRecord& /*state*/) {
+  }
 };
 
 }  // namespace morphfem

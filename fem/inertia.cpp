@@ -8,6 +8,7 @@
 
 #include "fem/assembly.h"
 #include "fem/petsc_check.h"
+#include "fem/term_state.h"
 
 namespace morphfem {
 
@@ -106,10 +107,14 @@ void InertiaTerm::set_initial_velocity(std::function<Eigen::Vector3d(const Eigen
   v0_ = std::move(v0);
 }
 
+void InertiaTerm::allocate(Assembler& assembler) {
+  for (Vec* v : {&u_n_, &v_n_, &a_n_, &u_nm1_, &v_nm1_, &pred_, &v_new_, &a_new_, &err_})
+    if (!*v) *v = assembler.create_vector();
+}
+
 void InertiaTerm::initialize(Assembler& assembler, Vec u0, double t0) {
   if (initialized()) return;
-  for (Vec* v : {&u_n_, &v_n_, &a_n_, &u_nm1_, &v_nm1_, &pred_, &v_new_, &a_new_, &err_})
-    *v = assembler.create_vector();
+  allocate(assembler);
   PETSC_CHECK(VecCopy(u0, u_n_));
   PETSC_CHECK(VecCopy(u0, u_nm1_));
   // v_0 = v0(X) on the free dofs; constrained dofs start at rest.
@@ -332,6 +337,34 @@ void InertiaTerm::end_step(Assembler& assembler, Vec u1, double /*t1*/) {
   h_prev_ = h_;
   ++steps_done_;
   have_a0_ = true;
+}
+
+// The history (u_n, v_n, a_n, u_{n-1}, v_{n-1}) and the step bookkeeping.
+void InertiaTerm::save_state(Assembler& assembler, const std::string& prefix, StateRecord& state) {
+  state.integers[prefix + ".initialized"] = initialized();
+  if (!initialized()) return;
+  const std::pair<const char*, Vec> history[] = {
+      {"u_n", u_n_}, {"v_n", v_n_}, {"a_n", a_n_}, {"u_nm1", u_nm1_}, {"v_nm1", v_nm1_}};
+  for (const auto& [key, v] : history) save_vector(assembler, v, prefix + "." + key, state);
+  state.integers[prefix + ".steps_done"] = steps_done_;
+  state.integers[prefix + ".have_a0"] = have_a0_;
+  state.set_number(prefix + ".h_prev", h_prev_);
+  state.set_number(prefix + ".last_error", last_error_);
+  state.set_number(prefix + ".suggested_dt", suggested_dt_);
+}
+
+void InertiaTerm::load_state(Assembler& assembler, const std::string& prefix, const StateRecord& state) {
+  const std::string where = "checkpoint: " + prefix;
+  if (!state.integer(prefix + ".initialized", where)) return;
+  allocate(assembler);
+  const std::pair<const char*, Vec> history[] = {
+      {"u_n", u_n_}, {"v_n", v_n_}, {"a_n", a_n_}, {"u_nm1", u_nm1_}, {"v_nm1", v_nm1_}};
+  for (const auto& [key, v] : history) load_vector(assembler, state, prefix + "." + key, v, where);
+  steps_done_ = static_cast<int>(state.integer(prefix + ".steps_done", where));
+  have_a0_ = state.integer(prefix + ".have_a0", where) != 0;
+  h_prev_ = state.number(prefix + ".h_prev", where);
+  last_error_ = state.number(prefix + ".last_error", where);
+  suggested_dt_ = state.number(prefix + ".suggested_dt", where);
 }
 
 // 1/2 v_n^T M v_n summed over this rank's cells, then over ranks [J].

@@ -117,6 +117,8 @@ class InertiaTerm : public EnergyTerm {
   void begin_step(Assembler& assembler, Vec u0, double t0, double t1) override;
   void end_step(Assembler& assembler, Vec u1, double t1) override;
   StepAdvice advise_step(Assembler& assembler, Vec u1, double t0, double t1) override;
+  void save_state(Assembler& assembler, const std::string& prefix, StateRecord& state) override;
+  void load_state(Assembler& assembler, const std::string& prefix, const StateRecord& state) override;
 
   // Initial velocity v_0(X) [m/s]; set before the first step.
   void set_initial_velocity(std::function<Eigen::Vector3d(const Eigen::Vector3d& X)> v0);
@@ -155,6 +157,7 @@ class InertiaTerm : public EnergyTerm {
   void step_accelerations(Vec u1, Vec v1, Vec a1);  // v_{n+1}, a_{n+1} of the current step
   double error_of(Assembler& assembler, Vec v1, Vec a1, double& dt_next);
   void equilibrium_acceleration(Assembler& assembler, Vec u0, double t0);
+  void allocate(Assembler& assembler);
 
   const Mesh& mesh_;
   std::vector<int> cells_;

@@ -7,6 +7,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <stdexcept>
 #include <system_error>
@@ -98,6 +99,16 @@ class Handle {
   hid_t id_;
   herr_t (*closer_)(hid_t);
 };
+
+// File access without HDF5 file locking: lets ParaView/h5py open the file while a
+// run is writing.
+Handle unlocked_access() {
+  Handle fapl(H5Pcreate(H5P_FILE_ACCESS), H5Pclose, "H5Pcreate(file access)");
+#if H5_VERSION_GE(1, 10, 7)
+  check(H5Pset_file_locking(fapl.get(), 0, 1), "H5Pset_file_locking");
+#endif
+  return fapl;
+}
 
 // Link-creation property list that creates missing intermediate groups.
 Handle make_lcpl() {
@@ -242,6 +253,31 @@ fs::path normalized_dir(const std::string& dir, const char* what) {
 // ---------------------------------------------------------------- ResultWriter
 
 ResultWriter::ResultWriter(const std::string& dir, const std::string& name, const Mesh& mesh) {
+  check_mesh(dir, name, mesh);
+  QuietHdf5 quiet;
+  file_ = check_id(H5Fcreate(h5_path_.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, unlocked_access().get()),
+                   "cannot create " + h5_path_);
+  try {
+    std::vector<hsize_t> xdims{static_cast<hsize_t>(n_nodes_), 3};
+    write_dataset(file_, "/mesh/X", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, xdims, mesh.X.data()).close("H5Dclose /mesh/X");
+    std::vector<hsize_t> cdims{static_cast<hsize_t>(n_cells_), static_cast<hsize_t>(mesh.nodes_per_cell())};
+    write_dataset(file_, "/mesh/cells", H5T_STD_I32LE, H5T_NATIVE_INT, cdims, mesh.cells.data())
+        .close("H5Dclose /mesh/cells");
+    if (have_regions_) {
+      std::vector<hsize_t> rdims{static_cast<hsize_t>(n_cells_)};
+      write_dataset(file_, "/mesh/cell_region", H5T_STD_I32LE, H5T_NATIVE_INT, rdims, mesh.cell_region.data())
+          .close("H5Dclose /mesh/cell_region");
+    }
+    check(H5Fflush(file_, H5F_SCOPE_GLOBAL), "H5Fflush " + h5_path_);
+    write_xdmf();
+  } catch (...) {
+    H5Fclose(file_);
+    file_ = -1;
+    throw;
+  }
+}
+
+void ResultWriter::check_mesh(const std::string& dir, const std::string& name, const Mesh& mesh) {
   check_name(name, "output file");
   if (!fs::is_directory(dir)) throw std::runtime_error("ResultWriter: output directory '" + dir + "' does not exist");
   if (mesh.order != 1 && mesh.order != 2) {
@@ -274,26 +310,119 @@ ResultWriter::ResultWriter(const std::string& dir, const std::string& name, cons
   h5_name_ = name + ".h5";
   h5_path_ = (fs::path(dir) / h5_name_).string();
   xdmf_path_ = (fs::path(dir) / (name + ".xdmf")).string();
+}
 
+namespace {
+
+// A dataset read whole as doubles or ints, with its dimensions.
+template <class T>
+std::vector<T> read_whole(hid_t file, const std::string& path, hid_t mem_type, std::vector<hsize_t>& dims) {
+  Handle d(H5Dopen2(file, path.c_str(), H5P_DEFAULT), H5Dclose, "H5Dopen2 " + path);
+  Handle space(H5Dget_space(d.get()), H5Sclose, "H5Dget_space " + path);
+  const int rank = H5Sget_simple_extent_ndims(space.get());
+  dims.assign(std::max(rank, 0), 0);
+  if (rank > 0) H5Sget_simple_extent_dims(space.get(), dims.data(), nullptr);
+  hsize_t n = 1;
+  for (hsize_t k : dims) n *= k;
+  std::vector<T> values(n);
+  if (n > 0) check(H5Dread(d.get(), mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, values.data()), "H5Dread " + path);
+  return values;
+}
+
+// Fixed-length string attribute (scalar or 1-D), as written by write_string_attribute.
+std::vector<std::string> read_string_attribute(hid_t obj, const std::string& name) {
+  Handle attr(H5Aopen(obj, name.c_str(), H5P_DEFAULT), H5Aclose, "H5Aopen " + name);
+  Handle type(H5Aget_type(attr.get()), H5Tclose, "H5Aget_type " + name);
+  Handle space(H5Aget_space(attr.get()), H5Sclose, "H5Aget_space " + name);
+  const size_t len = H5Tget_size(type.get());
+  const hssize_t n = std::max<hssize_t>(H5Sget_simple_extent_npoints(space.get()), 1);
+  std::vector<char> buf(len * n, '\0');
+  check(H5Aread(attr.get(), type.get(), buf.data()), "H5Aread " + name);
+  std::vector<std::string> out;
+  for (hssize_t i = 0; i < n; ++i) out.emplace_back(buf.data() + i * len, strnlen(buf.data() + i * len, len));
+  return out;
+}
+
+struct StepField {
+  std::string name;
+  int components;
+  std::string center;
+};
+
+herr_t collect_step_field(hid_t group, const char* name, const H5L_info_t*, void* out) {
+  Handle d(H5Dopen2(group, name, H5P_DEFAULT), H5Dclose, std::string("H5Dopen2 ") + name);
+  Handle space(H5Dget_space(d.get()), H5Sclose, "H5Dget_space");
+  hsize_t dims[2] = {0, 1};
+  const int rank = H5Sget_simple_extent_dims(space.get(), dims, nullptr);
+  const std::string center = read_string_attribute(d.get(), "center").at(0);
+  static_cast<std::vector<StepField>*>(out)->push_back({name, rank == 2 ? static_cast<int>(dims[1]) : 1, center});
+  return 0;
+}
+
+herr_t collect_name(hid_t, const char* name, const H5L_info_t*, void* out) {
+  static_cast<std::vector<std::string>*>(out)->push_back(name);
+  return 0;
+}
+
+}  // namespace
+
+ResultWriter::ResultWriter(const std::string& dir, const std::string& name, const Mesh& mesh, double resume_after) {
+  check_mesh(dir, name, mesh);
+  const std::string where = "ResultWriter: resuming " + h5_path_;
+  if (!fs::exists(h5_path_)) throw std::runtime_error(where + ": no such file");
   QuietHdf5 quiet;
-  {
-    // No file locking: lets ParaView/h5py open the file while a run is writing.
-    Handle fapl(H5Pcreate(H5P_FILE_ACCESS), H5Pclose, "H5Pcreate(file access)");
-#if H5_VERSION_GE(1, 10, 7)
-    check(H5Pset_file_locking(fapl.get(), 0, 1), "H5Pset_file_locking");
-#endif
-    file_ = check_id(H5Fcreate(h5_path_.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.get()), "cannot create " + h5_path_);
-  }
+  file_ = check_id(H5Fopen(h5_path_.c_str(), H5F_ACC_RDWR, unlocked_access().get()), "cannot open " + h5_path_);
   try {
-    std::vector<hsize_t> xdims{static_cast<hsize_t>(n_nodes_), 3};
-    write_dataset(file_, "/mesh/X", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, xdims, mesh.X.data()).close("H5Dclose /mesh/X");
-    std::vector<hsize_t> cdims{static_cast<hsize_t>(n_cells_), static_cast<hsize_t>(npc)};
-    write_dataset(file_, "/mesh/cells", H5T_STD_I32LE, H5T_NATIVE_INT, cdims, mesh.cells.data())
-        .close("H5Dclose /mesh/cells");
-    if (have_regions_) {
-      std::vector<hsize_t> rdims{static_cast<hsize_t>(n_cells_)};
-      write_dataset(file_, "/mesh/cell_region", H5T_STD_I32LE, H5T_NATIVE_INT, rdims, mesh.cell_region.data())
-          .close("H5Dclose /mesh/cell_region");
+    // The file must hold this very mesh.
+    std::vector<hsize_t> dims;
+    const auto X = read_whole<double>(file_, "/mesh/X", H5T_NATIVE_DOUBLE, dims);
+    const auto cells = read_whole<int>(file_, "/mesh/cells", H5T_NATIVE_INT, dims);
+    if (X.size() != static_cast<size_t>(mesh.X.size()) || !std::equal(X.begin(), X.end(), mesh.X.data()) ||
+        cells.size() != static_cast<size_t>(mesh.cells.size()) ||
+        !std::equal(cells.begin(), cells.end(), mesh.cells.data()))
+      throw std::runtime_error(where + ": its mesh differs from this run's");
+    // Steps: keep those at or before resume_after, drop the rest (written after the checkpoint).
+    const double eps = 1e-12 * std::max(1.0, std::abs(resume_after));
+    for (int step = 0;; ++step) {
+      const std::string label = step_label(step), group = "/steps/" + label;
+      if (H5Lexists(file_, "/steps", H5P_DEFAULT) <= 0 || H5Lexists(file_, group.c_str(), H5P_DEFAULT) <= 0) break;
+      double time = 0;
+      {
+        Handle g(H5Gopen2(file_, group.c_str(), H5P_DEFAULT), H5Gclose, "H5Gopen2 " + group);
+        Handle attr(H5Aopen(g.get(), "time", H5P_DEFAULT), H5Aclose, "H5Aopen time " + group);
+        check(H5Aread(attr.get(), H5T_NATIVE_DOUBLE, &time), "H5Aread time " + group);
+        if (time <= resume_after + eps && step == steps_) {
+          std::vector<StepField> fields;
+          hsize_t idx = 0;
+          check(H5Literate(g.get(), H5_INDEX_NAME, H5_ITER_INC, &idx, collect_step_field, &fields),
+                "H5Literate2 " + group);
+          std::vector<Field> nodal, cell;  // names and components only
+          for (const auto& f : fields) (f.center == "Node" ? nodal : cell).push_back(Field{f.name, f.components, {}});
+          grids_.push_back(grid_xml(label, time, nodal, cell));
+          ++steps_;
+          last_time_ = time;
+          continue;
+        }
+      }
+      check(H5Ldelete(file_, group.c_str(), H5P_DEFAULT), "H5Ldelete " + group);
+    }
+    // Tables: rows whose time (first column) is after resume_after go.
+    std::vector<std::string> tables;
+    if (H5Lexists(file_, "/tables", H5P_DEFAULT) > 0) {
+      hsize_t idx = 0;
+      Handle g(H5Gopen2(file_, "/tables", H5P_DEFAULT), H5Gclose, "H5Gopen2 /tables");
+      check(H5Literate(g.get(), H5_INDEX_NAME, H5_ITER_INC, &idx, collect_name, &tables), "H5Literate2 /tables");
+    }
+    for (const auto& table : tables) {
+      const std::string path = "/tables/" + table;
+      const auto values = read_whole<double>(file_, path, H5T_NATIVE_DOUBLE, dims);
+      if (dims.size() != 2 || dims[1] == 0) throw std::runtime_error(where + ": " + path + " is not a table");
+      long rows = 0;
+      while (rows < static_cast<long>(dims[0]) && values[rows * dims[1]] <= resume_after + eps) ++rows;
+      Handle d(H5Dopen2(file_, path.c_str(), H5P_DEFAULT), H5Dclose, "H5Dopen2 " + path);
+      hsize_t newdims[2] = {static_cast<hsize_t>(rows), dims[1]};
+      check(H5Dset_extent(d.get(), newdims), "H5Dset_extent " + path);
+      tables_[table] = Table{read_string_attribute(d.get(), "columns"), rows};
     }
     check(H5Fflush(file_, H5F_SCOPE_GLOBAL), "H5Fflush " + h5_path_);
     write_xdmf();
@@ -372,16 +501,6 @@ void ResultWriter::write_step(double time, const std::vector<Field>& nodal, cons
     g.close("H5Gclose " + group);
   }
 
-  const char* topology = order_ == 1 ? "Tetrahedron" : "Tetrahedron_10";
-  const int npc = order_ == 1 ? 4 : 10;
-  std::string xml = "      <Grid Name=\"step_" + label + "\" GridType=\"Uniform\">\n";
-  xml += "        <Time Value=\"" + number(time) + "\"/>\n";
-  xml += "        <Topology TopologyType=\"" + std::string(topology) + "\" NumberOfElements=\"" +
-         std::to_string(n_cells_) + "\" NodesPerElement=\"" + std::to_string(npc) + "\">\n          " +
-         data_item(dims_text(n_cells_, npc), "Int", 4, h5_name_ + ":/mesh/cells") + "\n        </Topology>\n";
-  xml += "        <Geometry GeometryType=\"XYZ\">\n          " +
-         data_item(dims_text(n_nodes_, 3), "Float", 8, h5_name_ + ":/mesh/X") + "\n        </Geometry>\n";
-
   auto write_fields = [&](const std::vector<Field>& fields, int rows, const char* center) {
     for (const Field& f : fields) {
       const std::string path = group + "/" + f.name;
@@ -390,23 +509,49 @@ void ResultWriter::write_step(double time, const std::vector<Field>& nodal, cons
       Handle d = write_dataset(file_, path, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, dims, f.values.data());
       write_string_attribute(d.get(), "center", {center}, true);
       d.close("H5Dclose " + path);
-      xml += attribute_xml(f.name, f.components, center, rows, h5_name_ + ":" + path);
     }
   };
   write_fields(nodal, n_nodes_, "Node");
   write_fields(cell, n_cells_, "Cell");
-  if (have_regions_ && std::find(names.begin(), names.end(), "region") == names.end()) {
-    // Stored once in /mesh; 32-bit integers.
-    xml += "        <Attribute Name=\"region\" AttributeType=\"Scalar\" Center=\"Cell\">\n          " +
-           data_item(std::to_string(n_cells_), "Int", 4, h5_name_ + ":/mesh/cell_region") + "\n        </Attribute>\n";
-  }
-  xml += "      </Grid>\n";
+  std::string xml = grid_xml(label, time, nodal, cell);
 
   check(H5Fflush(file_, H5F_SCOPE_GLOBAL), "H5Fflush " + h5_path_);
   grids_.push_back(std::move(xml));
   ++steps_;
   last_time_ = time;
   write_xdmf();
+}
+
+// XDMF <Grid> of one step: the mesh and the step's fields (only names and
+// components are used), plus the stored regions unless the step has its own.
+std::string ResultWriter::grid_xml(const std::string& label, double time, const std::vector<Field>& nodal,
+                                   const std::vector<Field>& cell) const {
+  const char* topology = order_ == 1 ? "Tetrahedron" : "Tetrahedron_10";
+  const int npc = order_ == 1 ? 4 : 10;
+  const std::string group = "/steps/" + label;
+  std::string xml = "      <Grid Name=\"step_" + label + "\" GridType=\"Uniform\">\n";
+  xml += "        <Time Value=\"" + number(time) + "\"/>\n";
+  xml += "        <Topology TopologyType=\"" + std::string(topology) + "\" NumberOfElements=\"" +
+         std::to_string(n_cells_) + "\" NodesPerElement=\"" + std::to_string(npc) + "\">\n          " +
+         data_item(dims_text(n_cells_, npc), "Int", 4, h5_name_ + ":/mesh/cells") + "\n        </Topology>\n";
+  xml += "        <Geometry GeometryType=\"XYZ\">\n          " +
+         data_item(dims_text(n_nodes_, 3), "Float", 8, h5_name_ + ":/mesh/X") + "\n        </Geometry>\n";
+  bool has_region = false;
+  for (const Field& f : nodal) {
+    xml += attribute_xml(f.name, f.components, "Node", n_nodes_, h5_name_ + ":" + group + "/" + f.name);
+    has_region = has_region || f.name == "region";
+  }
+  for (const Field& f : cell) {
+    xml += attribute_xml(f.name, f.components, "Cell", n_cells_, h5_name_ + ":" + group + "/" + f.name);
+    has_region = has_region || f.name == "region";
+  }
+  if (have_regions_ && !has_region) {
+    // Stored once in /mesh; 32-bit integers.
+    xml += "        <Attribute Name=\"region\" AttributeType=\"Scalar\" Center=\"Cell\">\n          " +
+           data_item(std::to_string(n_cells_), "Int", 4, h5_name_ + ":/mesh/cell_region") + "\n        </Attribute>\n";
+  }
+  xml += "      </Grid>\n";
+  return xml;
 }
 
 void ResultWriter::write_xdmf() const {

@@ -45,6 +45,12 @@ class ResultWriter {
   // geometry (reference coordinates X) and topology (Tetrahedron for P1,
   // Tetrahedron_10 for P2) once. Throws std::runtime_error on a bad mesh or I/O error.
   ResultWriter(const std::string& dir, const std::string& name, const Mesh& mesh);
+  // Resumes DIR/NAME.h5 and DIR/NAME.xdmf of an earlier writer on the same mesh (a
+  // run continued from a checkpoint at time resume_after [s]): checks that the file
+  // holds this mesh, drops the steps and table rows after resume_after (written
+  // after the checkpoint) and appends from there. Throws std::runtime_error if the
+  // file is missing or holds another mesh.
+  ResultWriter(const std::string& dir, const std::string& name, const Mesh& mesh, double resume_after);
   ~ResultWriter();  // closes the files; never throws (call close() to see errors)
   ResultWriter(const ResultWriter&) = delete;
   ResultWriter& operator=(const ResultWriter&) = delete;
@@ -76,6 +82,9 @@ class ResultWriter {
     long rows = 0;
   };
   void write_xdmf() const;
+  void check_mesh(const std::string& dir, const std::string& name, const Mesh& mesh);  // and sets the paths
+  std::string grid_xml(const std::string& label, double time, const std::vector<Field>& nodal,
+                       const std::vector<Field>& cell) const;
 
   std::string h5_name_, h5_path_, xdmf_path_;
   std::int64_t file_ = -1;  // hid_t; kept as int64 so hdf5.h stays out of this header

@@ -7,6 +7,7 @@
 
 #include "core/errors.h"
 #include "fem/petsc_check.h"
+#include "fem/term_state.h"
 
 namespace morphfem {
 
@@ -149,12 +150,68 @@ void QuasiStaticSolver::refresh_pieces() {
   int any = 0;
   MPI_Allreduce(&changed, &any, 1, MPI_INT, MPI_LOR, assembler_.comm());
   if (!any) return;
+  rebuild_pattern();
+  ++pattern_rebuilds_;
+}
+
+void QuasiStaticSolver::rebuild_pattern() {
   assembler_.setup();
   PETSC_CHECK(MatDestroy(&H_));
   H_ = assembler_.create_matrix();
   if (opt_.linear_solver == "gamg") attach_near_nullspace();
   set_jacobian();
-  ++pattern_rebuilds_;
+}
+
+void QuasiStaticSolver::save_state(StateRecord& state) {
+  const RunStats& counters = counters_;
+  save_vector(assembler_, u_, "solver.u", state);
+  save_vector(assembler_, u_prev_, "solver.u_prev", state);
+  state.set_number("solver.t", t_);
+  state.set_number("solver.dt_prev", dt_prev_);
+  state.set_number("solver.dt_next", dt_next_);
+  state.set_number("solver.fnorm_scale", fnorm_scale_);
+  state.integers["solver.pattern_rebuilds"] = pattern_rebuilds_;
+  state.integers["solver.steps"] = counters.steps;
+  state.integers["solver.newton_its"] = counters.newton_its;
+  state.integers["solver.linear_its"] = counters.linear_its;
+  state.integers["solver.step_cuts"] = counters.step_cuts;
+  state.integers["solver.error_rejections"] = counters.error_rejections;
+  state.integers["solver.terms"] = static_cast<long>(assembler_.terms().size());
+  for (size_t k = 0; k < assembler_.terms().size(); ++k) {
+    const std::string prefix = "term" + std::to_string(k);
+    if (assembler_.rank() == 0) state.texts[prefix] = assembler_.terms()[k]->name();
+    assembler_.terms()[k]->save_state(assembler_, prefix, state);
+  }
+}
+
+RunStats QuasiStaticSolver::load_state(const StateRecord& state, const std::string& where) {
+  const auto& terms = assembler_.terms();
+  if (state.integer("solver.terms", where) != static_cast<long>(terms.size()))
+    throw InputError(where, "the checkpoint has " + std::to_string(state.integer("solver.terms", where)) +
+                                " energy terms, this scene builds " + std::to_string(terms.size()));
+  for (size_t k = 0; k < terms.size(); ++k) {
+    const std::string prefix = "term" + std::to_string(k);
+    if (state.text(prefix, where) != terms[k]->name())
+      throw InputError(where, "energy term " + std::to_string(k) + " is '" + state.text(prefix, where) +
+                                  "' in the checkpoint, '" + terms[k]->name() + "' in this scene");
+  }
+  load_vector(assembler_, state, "solver.u", u_, where);
+  load_vector(assembler_, state, "solver.u_prev", u_prev_, where);
+  t_ = state.number("solver.t", where);
+  dt_prev_ = state.number("solver.dt_prev", where);
+  dt_next_ = state.number("solver.dt_next", where);
+  fnorm_scale_ = state.number("solver.fnorm_scale", where);
+  pattern_rebuilds_ = static_cast<int>(state.integer("solver.pattern_rebuilds", where));
+  RunStats counters;
+  counters.steps = static_cast<int>(state.integer("solver.steps", where));
+  counters.newton_its = static_cast<int>(state.integer("solver.newton_its", where));
+  counters.linear_its = static_cast<int>(state.integer("solver.linear_its", where));
+  counters.step_cuts = static_cast<int>(state.integer("solver.step_cuts", where));
+  counters.error_rejections = static_cast<int>(state.integer("solver.error_rejections", where));
+  counters_ = counters;
+  for (size_t k = 0; k < terms.size(); ++k) terms[k]->load_state(assembler_, "term" + std::to_string(k), state);
+  rebuild_pattern();  // pieces that depend on the state (self-contact candidates) were rebuilt
+  return counters;
 }
 
 void QuasiStaticSolver::clear_low_rank() {
@@ -414,12 +471,14 @@ bool QuasiStaticSolver::solve_step(double t_new, int& newton_its, int& linear_it
 
 RunStats QuasiStaticSolver::run(const std::function<void(const StepReport&)>& on_step) {
   auto start = std::chrono::steady_clock::now();
-  RunStats stats;
+  RunStats stats = counters_;
+  stats.completed = false;
+  stats.failure.clear();
   for (const auto& term : assembler_.terms()) term->set_time(t_);
   std::vector<double> stops = opt_.output_times;
   stops.push_back(opt_.t_end);
   std::sort(stops.begin(), stops.end());
-  double dt = std::min(opt_.dt_initial, opt_.dt_max);
+  double dt = dt_next_ > 0 ? std::min(dt_next_, opt_.dt_max) : std::min(opt_.dt_initial, opt_.dt_max);
   int cuts = 0;
   const double eps = 1e-12 * std::max(1.0, opt_.t_end);
   while (t_ < opt_.t_end - eps) {
@@ -440,10 +499,12 @@ RunStats QuasiStaticSolver::run(const std::function<void(const StepReport&)>& on
       stats.newton_its += its;
       stats.linear_its += lits;
       StepReport report{stats.steps, t_, dt_prev_, its, lits, cuts, assembler_.energy(u_)};
-      if (on_step) on_step(report);
       if (its <= opt_.easy_newton_its && cuts == 0) dt = std::min(dt * opt_.grow, opt_.dt_max);
       dt = std::min(dt, advised_dt_);
+      dt_next_ = dt;  // before on_step, which may save a checkpoint
+      counters_ = stats;
       cuts = 0;
+      if (on_step) on_step(report);
     } else if (why == "time-step error estimate above tolerance" && advised_dt_ < t_new - t_) {
       ++stats.error_rejections;
       dt = advised_dt_;

@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "core/state_file.h"
 #include "fem/assembly.h"
 
 namespace morphfem {
@@ -72,6 +73,15 @@ class QuasiStaticSolver {
   // last converged state and stats.failure says which step, time and why.
   RunStats run(const std::function<void(const StepReport&)>& on_step = {});
 
+  // Checkpoints (between runs or from an on_step callback): the state, the time,
+  // the step the next attempt takes, the counters and every term's history
+  // (EnergyTerm::save_state) under "solver.*" and "term<k>.*". load_state restores
+  // them exactly (collective; `state` on every rank), so run() continues the same
+  // sequence of steps; the counters (steps, Newton iterations, cuts; not wall_s) of
+  // the next run() continue from the saved ones.
+  void save_state(StateRecord& state);
+  RunStats load_state(const StateRecord& state, const std::string& where);
+
   Vec solution() const { return u_; }
   double time() const { return t_; }
   Assembler& assembler() { return assembler_; }
@@ -88,6 +98,7 @@ class QuasiStaticSolver {
   void apply_dirichlet(Vec u, double t) const;
   void set_jacobian();    // (re)attach the Hessian (and shell operator) to SNES
   void refresh_pieces();  // lets terms rebuild state-dependent pieces (then a new pattern)
+  void rebuild_pattern();
   void attach_near_nullspace();
   bool solve_step(double t_new, int& newton_its, int& linear_its, std::string& why);
 
@@ -101,14 +112,15 @@ class QuasiStaticSolver {
   void clear_low_rank();
   SNES snes_ = nullptr;
   double t_ = 0.0, dt_prev_ = 0.0;
+  double dt_next_ = 0.0;  // the next step run() tries (0: dt_initial)
+  RunStats counters_;     // where run()'s counters start (load_state)
   int pattern_rebuilds_ = 0;
   double fnorm0_ = 0.0, fnorm_scale_ = 0.0;
   double fnorm_prev_ = 0.0;                     // residual of the previous iteration [N]
   int stalled_its_ = 0;                         // consecutive iterations without a 10 % residual decrease
   PetscBool linesearch_monitor_ = PETSC_FALSE;  // -morphfem_linesearch_monitor (read once)
-  double length_scale_ = 1.0;
-  double advised_dt_ =
-      1e300;  // smallest dt_next advised by the terms for the last attempt  // diagonal of the mesh's bounding box [m]
+  double length_scale_ = 1.0;                   // diagonal of the mesh's bounding box [m]
+  double advised_dt_ = 1e300;                   // smallest dt_next advised by the terms for the last attempt
 };
 
 }  // namespace morphfem

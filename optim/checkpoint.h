@@ -1,9 +1,5 @@
-// Search checkpoints: the whole SearchState in one HDF5 file (C API).
-//   root attributes: every integer (int64) and text (fixed-length string)
-//   root datasets:   every array (1-D, double)
-// Written to PATH.tmp and renamed over PATH, so a run killed at any moment leaves
-// either the previous or the new checkpoint, never a broken one. No time stamps
-// are stored (object time tracking is off): equal states give identical bytes.
+// Search checkpoints: the whole SearchState in one state file (core/state_file.h:
+// atomic, byte-identical for equal states).
 #pragma once
 #include <string>
 

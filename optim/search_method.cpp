@@ -36,22 +36,6 @@ std::vector<std::string> search_method_names() {
   return names;
 }
 
-long SearchState::integer(const std::string& key, const std::string& where) const {
-  auto it = integers.find(key);
-  if (it == integers.end()) throw InputError(where, "missing integer '" + key + "'");
-  return it->second;
-}
-
-const std::vector<double>& SearchState::array(const std::string& key, const std::string& where,
-                                              long expected_size) const {
-  auto it = arrays.find(key);
-  if (it == arrays.end()) throw InputError(where, "missing array '" + key + "'");
-  if (expected_size >= 0 && static_cast<long>(it->second.size()) != expected_size)
-    throw InputError(where, "array '" + key + "' has " + std::to_string(it->second.size()) + " values, expected " +
-                                std::to_string(expected_size));
-  return it->second;
-}
-
 std::vector<double> genomes_to_array(const std::vector<Genome>& genomes) {
   std::vector<double> a;
   for (const auto& g : genomes) {

@@ -12,21 +12,14 @@
 #include <string>
 #include <vector>
 
+#include "core/state_file.h"
 #include "optim/genome.h"
 
 namespace morphfem {
 
 // Everything a checkpoint holds, for any method: named integers, texts and
 // double arrays. A method's save() fills it, restore() reads it back exactly.
-struct SearchState {
-  std::map<std::string, long> integers;
-  std::map<std::string, std::string> texts;
-  std::map<std::string, std::vector<double>> arrays;
-
-  // Throw InputError(where, ...) if the entry is missing or has the wrong length (expected_size >= 0).
-  long integer(const std::string& key, const std::string& where) const;
-  const std::vector<double>& array(const std::string& key, const std::string& where, long expected_size = -1) const;
-};
+using SearchState = StateRecord;
 
 struct SearchSetup {
   GenomeSpace space;

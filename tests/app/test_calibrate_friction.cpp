@@ -123,7 +123,7 @@ TEST(CalibrateFriction, PullsSceneKeyIsParsedCheckedAndReported) {
   EXPECT_EQ(s.pulls[0].surface, "xmax");
   EXPECT_DOUBLE_EQ(s.pulls[0].stiffness, 1000.0);
   EXPECT_DOUBLE_EQ(s.pulls[0].velocity.x(), 1e-3);
-  const SimulationResult r = run_scene(s, PETSC_COMM_WORLD, {true, false, {}});
+  const SimulationResult r = run_scene(s, PETSC_COMM_WORLD, {true, false});
   ASSERT_TRUE(r.stats.completed);
   // A clamped elastic block pulled 1 mm through a 1000 N/m spring: the spring force
   // k (a - xbar) is below k * 1 mm = 1 N (the block stretches) and positive.
@@ -141,7 +141,7 @@ TEST(CalibrateFriction, PullsSceneKeyIsParsedCheckedAndReported) {
                InputError);
   const Scene unknown = read_scene(
       write("unknown.yaml", base + "loads:\n  pulls:\n    - {surface: nowhere, stiffness: 1, velocity: [1, 0, 0]}\n"));
-  EXPECT_THROW(run_scene(unknown, PETSC_COMM_WORLD, {false, false, {}}), InputError);
+  EXPECT_THROW(run_scene(unknown, PETSC_COMM_WORLD, {false, false}), InputError);
   std::filesystem::remove_all(dir);
 }
 

@@ -54,7 +54,7 @@ std::string error_of(const std::string& text) {
   TempScene s(text);
   try {
     Scene scene = read_scene(s.file.string());
-    run_scene(scene, PETSC_COMM_WORLD, {true, false, {}});
+    run_scene(scene, PETSC_COMM_WORLD, {true, false});
   } catch (const InputError& e) {
     EXPECT_FALSE(fs::exists(s.dir / "out")) << "bad input left output behind";
     EXPECT_FALSE(fs::exists(s.dir / "out.partial")) << "bad input left output behind";
@@ -74,7 +74,7 @@ std::string replace(std::string text, const std::string& from, const std::string
 TEST(Scene, GoodSceneRunsAndWritesResults) {
   TempScene s(kGood);
   Scene scene = read_scene(s.file.string());
-  auto r = run_scene(scene, PETSC_COMM_WORLD, {true, false, {}});
+  auto r = run_scene(scene, PETSC_COMM_WORLD, {true, false});
   EXPECT_TRUE(r.stats.completed);
   EXPECT_TRUE(fs::exists(s.dir / "out" / "cube.xdmf"));
   EXPECT_TRUE(fs::exists(s.dir / "out" / "cube.h5"));
@@ -158,7 +158,7 @@ solver: {end_time: 1, initial_step: 0.25}
   Scene scene = read_scene(s.file.string());
   ASSERT_EQ(scene.membranes.size(), 1u);
   scene.boundary[1].components = {true, false, false};  // xmax: only u_x prescribed (free across)
-  const auto r = run_scene(scene, PETSC_COMM_WORLD, {false, false, {}});
+  const auto r = run_scene(scene, PETSC_COMM_WORLD, {false, false});
   ASSERT_TRUE(r.stats.completed);
   double y_max = 0;
   for (int n : r.mesh.nodes_of_surface("zmax")) y_max = std::max(y_max, r.mesh.X(n, 1) + r.u(n, 1));
@@ -166,7 +166,7 @@ solver: {end_time: 1, initial_step: 0.25}
   EXPECT_NEAR(y_max / 0.02, 1.0 / std::sqrt(1.5), 2e-4);
   // Without the sheet the soft block (nu 0.3) contracts much less: the sheet decides.
   scene.membranes.clear();
-  const auto bare = run_scene(scene, PETSC_COMM_WORLD, {false, false, {}});
+  const auto bare = run_scene(scene, PETSC_COMM_WORLD, {false, false});
   double y_bare = 0;
   for (int n : bare.mesh.nodes_of_surface("zmax")) y_bare = std::max(y_bare, bare.mesh.X(n, 1) + bare.u(n, 1));
   EXPECT_GT(y_bare / 0.02, 0.85);
@@ -189,8 +189,8 @@ TEST(Scene, GamgWithRigidBodyNearNullspaceMatchesMumps) {
                                    "mu: 1.0e5, kappa: 1.0e6, density: 1000}\nloads: {gravity: [3.0, 0, -9.81]}");
   TempScene direct(text);
   TempScene iterative(replace(text, "initial_step: 0.5}", "initial_step: 0.5, linear_solver: gamg}"), "gamg.yaml");
-  auto a = run_scene(read_scene(direct.file.string()), PETSC_COMM_WORLD, {false, false, {}});
-  auto b = run_scene(read_scene(iterative.file.string()), PETSC_COMM_WORLD, {false, false, {}});
+  auto a = run_scene(read_scene(direct.file.string()), PETSC_COMM_WORLD, {false, false});
+  auto b = run_scene(read_scene(iterative.file.string()), PETSC_COMM_WORLD, {false, false});
   ASSERT_TRUE(a.stats.completed && b.stats.completed);
   EXPECT_LT((a.u - b.u).cwiseAbs().maxCoeff(), 1e-7 * a.u.cwiseAbs().maxCoeff());
 }
@@ -201,7 +201,7 @@ TEST(Scene, EveryExampleSceneRuns) {
   for (const auto& entry : fs::directory_iterator(fs::path(MORPHFEM_SOURCE_DIR) / "examples")) {
     if (entry.path().extension() != ".yaml") continue;
     Scene scene = read_scene(entry.path().string());
-    auto r = run_scene(scene, PETSC_COMM_WORLD, {false, false, {}});
+    auto r = run_scene(scene, PETSC_COMM_WORLD, {false, false});
     EXPECT_TRUE(r.stats.completed) << entry.path() << ": " << r.stats.failure;
     EXPECT_GT(r.min_J, 0.0) << entry.path();
     ++count;
@@ -225,7 +225,7 @@ TEST(Scene, EveryRobotSceneReads) {
 TEST(Scene, GasCavityFillsTowardsTheSupplyPressure) {
   Scene scene = read_scene(std::string(MORPHFEM_SOURCE_DIR) + "/examples/balloon_valve.yaml");
   std::vector<double> pressure;
-  RunOptions options{false, false, {}};
+  RunOptions options{false, false};
   options.on_step = [&](double, const Mesh&, const RowMatrixXd&, const SimulationResult& r) {
     pressure.push_back(r.cavity_pressure.at(0));
   };
@@ -258,7 +258,7 @@ solver: {end_time: 1, initial_step: 0.1, max_step: 0.1, min_step: 1.0e-3, formul
 output: {directory: OUT}
 )");
   Scene scene = read_scene(s.file.string());
-  auto r = run_scene(scene, PETSC_COMM_WORLD, {true, false, {}});
+  auto r = run_scene(scene, PETSC_COMM_WORLD, {true, false});
   EXPECT_FALSE(r.stats.completed);
   EXPECT_NE(r.stats.failure.find("no convergence"), std::string::npos) << r.stats.failure;
   EXPECT_NE(r.stats.failure.find("t = "), std::string::npos) << r.stats.failure;
@@ -297,7 +297,7 @@ solver: {end_time: 1, initial_step: 0.02, max_step: 0.02, formulation: mean_dila
   ASSERT_EQ(scene.volume_cavities.size(), 1u);
   std::vector<std::pair<double, double>> curve;  // (inner stretch, gauge pressure)
   double worst = 0, V_ref = 0;
-  RunOptions options{false, false, {}};
+  RunOptions options{false, false};
   options.on_step = [&](double t, const Mesh&, const RowMatrixXd&, const SimulationResult& r) {
     if (t == 0.0) V_ref = r.cavity_volume.at(0);  // the first record is the reference state
     const double ratio = r.cavity_volume.at(0) / V_ref;
@@ -341,7 +341,7 @@ solver: {end_time: 10.4, initial_step: 0.3, max_step: 0.3}
   Scene scene = read_scene(s.file.string());
   ASSERT_EQ(scene.cavities.size(), 1u);
   std::vector<std::pair<double, double>> volume;  // (gait time, volume)
-  RunOptions options{false, false, {}};
+  RunOptions options{false, false};
   options.on_step = [&](double t, const Mesh&, const RowMatrixXd&, const SimulationResult& r) {
     volume.emplace_back(t - 0.5, r.cavity_volume.at(0));
   };
@@ -376,7 +376,7 @@ solver: {end_time: 10.4, initial_step: 0.05, max_step: 0.05}
   auto at_column_8 = [&](const std::string& valves, double& pressure, double& volume) {
     TempScene s(replace(text, "VALVES", valves));
     Scene scene = read_scene(s.file.string());
-    RunOptions options{false, false, {}};
+    RunOptions options{false, false};
     options.on_step = [&](double t, const Mesh&, const RowMatrixXd&, const SimulationResult& r) {
       if (std::abs(t - t8) < 1e-9) {
         pressure = r.cavity_pressure.at(0);

@@ -74,7 +74,7 @@ TEST(MeanDilatationSolve, PatchTestIsExactOnADistortedP2Mesh) {
     s.boundary.push_back(b);
   }
   s.solver.dt_initial = 0.5;
-  auto r = run_scene(s, PETSC_COMM_WORLD, {false, false, {}});
+  auto r = run_scene(s, PETSC_COMM_WORLD, {false, false});
   ASSERT_TRUE(r.stats.completed) << r.stats.failure;
   double err = 0;
   for (int n = 0; n < r.mesh.n_nodes(); ++n)
@@ -88,7 +88,7 @@ TEST(MeanDilatationSolve, ConvergesToTheDisplacementSolutionAtModerateKappaAndUn
   // shrinks under refinement (mean dilatation is O(h) in H1, so it is the larger
   // error on coarse meshes).
   auto top_ux = [](const std::string& formulation, double nu, int divisions) {
-    auto r = run_scene(sheared_cube(formulation, nu, 2, divisions), PETSC_COMM_WORLD, {false, false, {}});
+    auto r = run_scene(sheared_cube(formulation, nu, 2, divisions), PETSC_COMM_WORLD, {false, false});
     EXPECT_TRUE(r.stats.completed) << r.stats.failure;
     return mean_top_ux(r);
   };
@@ -102,7 +102,7 @@ TEST(MeanDilatationSolve, ConvergesToTheDisplacementSolutionAtModerateKappaAndUn
 
 TEST(MeanDilatationSolve, LinearTetrahedraAreRejectedWithAClearMessage) {
   try {
-    run_scene(sheared_cube("mean_dilatation", 0.45, 1), PETSC_COMM_WORLD, {false, false, {}});
+    run_scene(sheared_cube("mean_dilatation", 0.45, 1), PETSC_COMM_WORLD, {false, false});
     FAIL() << "expected InputError";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("P2"), std::string::npos) << e.what();

@@ -453,6 +453,43 @@ TEST(ResultWriter, ReadableAfterCrash) {
   check_xdmf_against_h5(dir.str(), "crash", {0.0, 0.25, 0.5});
 }
 
+// A resumed writer keeps the steps and table rows up to the checkpoint time, drops
+// the later ones (written after the checkpoint), appends after them, and refuses a
+// file of another mesh.
+TEST(ResultWriter, ResumesAfterACheckpoint) {
+  TempDir dir;
+  const Mesh mesh = p1_mesh();
+  auto steps = write_three_steps(dir.str(), "run", mesh);  // t = 0, 0.1, 0.35
+  {
+    ResultWriter w(dir.str(), "run", mesh, 0.1);
+    EXPECT_EQ(w.steps_written(), 2);
+  }
+  check_xdmf_against_h5(dir.str(), "run", {0.0, 0.1});
+  {
+    ResultWriter w(dir.str(), "run", mesh, 0.1);  // again: nothing more to drop
+    EXPECT_EQ(w.steps_written(), 2);
+    expect_throw_containing([&] { w.write_step(0.1, {make_field("displacement", 3, 5, 7)}, {}); },
+                            {"time must increase"});
+    w.write_step(0.2, {make_field("displacement", 3, 5, 7)}, {});
+    w.append_row("energy", {"time", "elastic"}, {0.2, 9.0});
+    expect_throw_containing([&] { w.append_row("energy", {"time", "kinetic"}, {0.3, 1.0}); }, {"columns differ"});
+  }
+  check_xdmf_against_h5(dir.str(), "run", {0.0, 0.1, 0.2});
+  hid_t f = open_readonly(dir.str() + "/run.h5");
+  ASSERT_GE(f, 0);
+  EXPECT_EQ(read_dataset(f, "/steps/000001/displacement").values, steps[1].first[0].values);
+  EXPECT_EQ(read_dataset(f, "/steps/000002/displacement").values, make_field("displacement", 3, 5, 7).values);
+  EXPECT_EQ(read_dataset(f, "/tables/energy").values, (std::vector<double>{0.0, 0.0, 0.1, 0.5, 0.2, 9.0}));
+  EXPECT_EQ(read_dataset(f, "/tables/cavities").dims, (std::vector<hsize_t>{2, 3}));
+  EXPECT_GE(H5Fclose(f), 0);
+
+  expect_throw_containing([&] { ResultWriter w(dir.str(), "run", p2_mesh(), 0.1); }, {"mesh differs"});
+  Mesh moved = mesh;
+  moved.X(0, 0) += 1e-9;
+  expect_throw_containing([&] { ResultWriter w(dir.str(), "run", moved, 0.1); }, {"mesh differs"});
+  expect_throw_containing([&] { ResultWriter w(dir.str(), "none", mesh, 0.1); }, {"no such file"});
+}
+
 TEST(OutputDir, PartialThenCommitAndReplace) {
   TempDir dir;
   const std::string final_dir = (dir.path / "results").string();
