@@ -137,6 +137,76 @@ std::string first_difference(const std::string& a, const std::string& b) {
   }
 }
 
+// A resumed run's checkpoint: its directory, its file (`where`, for messages) and its state.
+struct ResumePoint {
+  std::string dir, where;
+  StateRecord state;
+};
+
+// Finds and reads the checkpoint on rank 0, sends it to every rank and checks it
+// against this run: the rank count, the mesh, the scene (but the keys
+// scene_identity drops) and an end time still ahead. Collective.
+ResumePoint read_checkpoint_to_resume(const Scene& scene, const Mesh& mesh, const std::string& scene_text, double t_end,
+                                      MPI_Comm comm) {
+  int rank = 0, size = 1;
+  MPI_Comm_rank(comm, &rank);
+  MPI_Comm_size(comm, &size);
+  ResumePoint point;
+  std::string error;
+  if (rank == 0) {
+    try {
+      point.dir = checkpoint_to_resume(scene);
+      point.state = read_state_file(point.dir + "/checkpoint.h5");
+    } catch (const InputError& e) {
+      error = e.what();
+    }
+  }
+  bcast_string(error, comm);
+  if (!error.empty()) throw InputError("", error);
+  bcast_string(point.dir, comm);
+  broadcast_state(point.state, comm);
+  point.where = point.dir + "/checkpoint.h5";
+  const StateRecord& saved = point.state;
+  const std::string& where = point.where;
+  const long ranks = saved.integer("run.ranks", where);
+  if (ranks != size)
+    throw InputError(where, "written by a run on " + std::to_string(ranks) +
+                                " ranks; resume it with the same number (mpirun -n " + std::to_string(ranks) + ")");
+  const long nodes = saved.integer("run.nodes", where), cells = saved.integer("run.cells", where);
+  if (nodes != mesh.n_nodes() || cells != mesh.n_cells())
+    throw InputError(where, "its mesh has " + std::to_string(nodes) + " nodes and " + std::to_string(cells) +
+                                " cells, this scene's " + std::to_string(mesh.n_nodes()) + " and " +
+                                std::to_string(mesh.n_cells()));
+  const std::string diff = first_difference(saved.text("run.scene", where), scene_text);
+  if (!diff.empty())
+    throw InputError(
+        where,
+        "the scene differs from the checkpoint's (only solver.end_time and output.checkpoint_s may change): " + diff);
+  const double t_saved = saved.number("solver.t", where);
+  if (!(t_saved < t_end - 1e-12 * std::max(1.0, t_end)))
+    throw InputError(where, "the checkpoint is at t = " + std::to_string(t_saved) +
+                                " s; set a later solver.end_time (now " + std::to_string(t_end) + " s) to extend it");
+  return point;
+}
+
+// Extending a finished run: its output is copied to the partial directory, which
+// replaces it when this run ends (the finished results stay until then). Collective.
+void reopen_finished_output(const Scene& scene, MPI_Comm comm) {
+  int rank = 0;
+  MPI_Comm_rank(comm, &rank);
+  std::string error;
+  if (rank == 0) {
+    namespace fs = std::filesystem;
+    const std::string partial = scene.output_dir + ".partial";
+    std::error_code ec;
+    fs::remove_all(partial, ec);
+    fs::copy(scene.output_dir, partial, fs::copy_options::recursive, ec);
+    if (ec) error = "cannot copy " + scene.output_dir + " to " + partial + ": " + ec.message();
+  }
+  bcast_string(error, comm);
+  if (!error.empty()) throw InputError("--resume", error);
+}
+
 }  // namespace
 
 std::string scene_identity(const YAML::Node& doc) {
@@ -364,57 +434,15 @@ SimulationResult run_scene(const Scene& scene, MPI_Comm comm, const RunOptions& 
   const bool write = options.write_output && !scene.output_dir.empty();
   if (options.resume && !write)
     throw InputError(scene_key(scene, "", "output.directory"), "--resume needs the scene's output directory");
-  // Resuming: the checkpoint, read on rank 0, checked and sent to every rank.
-  StateRecord checkpoint;
+  // Resuming: the checkpoint, checked against this run, and the solver's state from it.
+  ResumePoint checkpoint;
   double wall_before = 0.0;  // wall time of the earlier parts of a resumed run [s]
   if (options.resume) {
-    std::string error, from;
-    if (rank == 0) {
-      try {
-        from = checkpoint_to_resume(scene);
-        checkpoint = read_state_file(from + "/checkpoint.h5");
-      } catch (const InputError& e) {
-        error = e.what();
-      }
-    }
-    bcast_string(error, comm);
-    if (!error.empty()) throw InputError("", error);
-    bcast_string(from, comm);
-    broadcast_state(checkpoint, comm);
-    const std::string where = from + "/checkpoint.h5";
-    if (checkpoint.integer("run.ranks", where) != size)
-      throw InputError(where, "written by a run on " + std::to_string(checkpoint.integer("run.ranks", where)) +
-                                  " ranks; resume it with the same number (mpirun -n " +
-                                  std::to_string(checkpoint.integer("run.ranks", where)) + ")");
-    if (checkpoint.integer("run.nodes", where) != mesh.n_nodes() ||
-        checkpoint.integer("run.cells", where) != mesh.n_cells())
-      throw InputError(where, "its mesh has " + std::to_string(checkpoint.integer("run.nodes", where)) + " nodes and " +
-                                  std::to_string(checkpoint.integer("run.cells", where)) + " cells, this scene's " +
-                                  std::to_string(mesh.n_nodes()) + " and " + std::to_string(mesh.n_cells()));
-    const std::string diff = first_difference(checkpoint.text("run.scene", where), options.scene_text);
-    if (!diff.empty())
-      throw InputError(
-          where,
-          "the scene differs from the checkpoint's (only solver.end_time and output.checkpoint_s may change): " + diff);
-    const double t_saved = checkpoint.number("solver.t", where);
-    if (!(t_saved < t_end - 1e-12 * std::max(1.0, t_end)))
-      throw InputError(where, "the checkpoint is at t = " + std::to_string(t_saved) +
-                                  " s; set a later solver.end_time (now " + std::to_string(t_end) + " s) to extend it");
-    result.stats = solver.load_state(checkpoint, where);
-    result.resumed_at = t_saved;
-    wall_before = checkpoint.number("run.wall_s", where);
-    // Extending a finished run: its output is copied to the partial directory, which
-    // replaces it when this run ends (the finished results stay until then).
-    if (rank == 0 && from == scene.output_dir) {
-      namespace fs = std::filesystem;
-      const std::string partial = scene.output_dir + ".partial";
-      std::error_code ec;
-      fs::remove_all(partial, ec);
-      fs::copy(from, partial, fs::copy_options::recursive, ec);
-      if (ec) error = "cannot copy " + from + " to " + partial + ": " + ec.message();
-    }
-    bcast_string(error, comm);
-    if (!error.empty()) throw InputError("--resume", error);
+    checkpoint = read_checkpoint_to_resume(scene, mesh, options.scene_text, t_end, comm);
+    result.stats = solver.load_state(checkpoint.state, checkpoint.where);
+    result.resumed_at = checkpoint.state.number("solver.t", checkpoint.where);
+    wall_before = checkpoint.state.number("run.wall_s", checkpoint.where);
+    if (checkpoint.dir == scene.output_dir) reopen_finished_output(scene, comm);
   }
   std::string tmp_dir;
   std::unique_ptr<ResultWriter> writer;
@@ -583,14 +611,15 @@ SimulationResult run_scene(const Scene& scene, MPI_Comm comm, const RunOptions& 
     write_state_file(dir + "/checkpoint.h5", state);
   };
   if (options.resume) {
-    const std::string where = "checkpoint";
-    last_written = static_cast<int>(checkpoint.integer("run.last_written", where));
-    friction_dissipated = checkpoint.number("run.friction_dissipated", where);
-    heading_at_start = checkpoint.number("run.heading_at_start", where);
-    result.gait_complete = checkpoint.integer("run.gait_complete", where) != 0;
-    result.gait_displacement_m = checkpoint.number("run.gait_displacement_m", where);
-    result.speed_bl_per_s = checkpoint.number("run.speed_bl_per_s", where);
-    const auto& path = checkpoint.array("run.trajectory", where);
+    const StateRecord& saved = checkpoint.state;
+    const std::string& where = checkpoint.where;
+    last_written = static_cast<int>(saved.integer("run.last_written", where));
+    friction_dissipated = saved.number("run.friction_dissipated", where);
+    heading_at_start = saved.number("run.heading_at_start", where);
+    result.gait_complete = saved.integer("run.gait_complete", where) != 0;
+    result.gait_displacement_m = saved.number("run.gait_displacement_m", where);
+    result.speed_bl_per_s = saved.number("run.speed_bl_per_s", where);
+    const auto& path = saved.array("run.trajectory", where);
     for (size_t i = 0; i + 3 < path.size(); i += 4)
       result.trajectory.push_back({path[i], path[i + 1], path[i + 2], path[i + 3]});
   }

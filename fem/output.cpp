@@ -257,7 +257,7 @@ ResultWriter::ResultWriter(const std::string& dir, const std::string& name, cons
   QuietHdf5 quiet;
   file_ = check_id(H5Fcreate(h5_path_.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, unlocked_access().get()),
                    "cannot create " + h5_path_);
-  try {
+  fill_or_close([&] {
     std::vector<hsize_t> xdims{static_cast<hsize_t>(n_nodes_), 3};
     write_dataset(file_, "/mesh/X", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, xdims, mesh.X.data()).close("H5Dclose /mesh/X");
     std::vector<hsize_t> cdims{static_cast<hsize_t>(n_cells_), static_cast<hsize_t>(mesh.nodes_per_cell())};
@@ -270,11 +270,7 @@ ResultWriter::ResultWriter(const std::string& dir, const std::string& name, cons
     }
     check(H5Fflush(file_, H5F_SCOPE_GLOBAL), "H5Fflush " + h5_path_);
     write_xdmf();
-  } catch (...) {
-    H5Fclose(file_);
-    file_ = -1;
-    throw;
-  }
+  });
 }
 
 void ResultWriter::check_mesh(const std::string& dir, const std::string& name, const Mesh& mesh) {
@@ -372,7 +368,7 @@ ResultWriter::ResultWriter(const std::string& dir, const std::string& name, cons
   if (!fs::exists(h5_path_)) throw std::runtime_error(where + ": no such file");
   QuietHdf5 quiet;
   file_ = check_id(H5Fopen(h5_path_.c_str(), H5F_ACC_RDWR, unlocked_access().get()), "cannot open " + h5_path_);
-  try {
+  fill_or_close([&] {
     // The file must hold this very mesh.
     std::vector<hsize_t> dims;
     const auto X = read_whole<double>(file_, "/mesh/X", H5T_NATIVE_DOUBLE, dims);
@@ -426,6 +422,12 @@ ResultWriter::ResultWriter(const std::string& dir, const std::string& name, cons
     }
     check(H5Fflush(file_, H5F_SCOPE_GLOBAL), "H5Fflush " + h5_path_);
     write_xdmf();
+  });
+}
+
+void ResultWriter::fill_or_close(const std::function<void()>& fill) {
+  try {
+    fill();
   } catch (...) {
     H5Fclose(file_);
     file_ = -1;

@@ -25,6 +25,7 @@
 // can read it while a run is still writing (between steps).
 #pragma once
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <string>
 #include <vector>
@@ -83,6 +84,8 @@ class ResultWriter {
   };
   void write_xdmf() const;
   void check_mesh(const std::string& dir, const std::string& name, const Mesh& mesh);  // and sets the paths
+  // Runs `fill` on the file just opened; if it throws, closes the file and rethrows.
+  void fill_or_close(const std::function<void()>& fill);
   std::string grid_xml(const std::string& label, double time, const std::vector<Field>& nodal,
                        const std::vector<Field>& cell) const;
 

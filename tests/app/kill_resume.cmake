@@ -7,22 +7,12 @@
 #    match the uninterrupted run's (relative 1e-10), and the result has every step.
 file(REMOVE_RECURSE ${WORK})
 file(MAKE_DIRECTORY ${WORK})
-file(WRITE ${WORK}/slide.yaml [=[
-name: slide
-geometry: {type: block, lx: 0.04, ly: 0.04, lz: 0.01, mesh_size: 0.005, order: 1}
-materials:
-  body: {model: neo_hookean, mu: 1.0e6, nu: 0.3, density: 1000}
-loads:
-  gravity: [4.38, 0, -8.77]
-contact:
-  ground: {point: [0, 0, -2.0e-5], normal: [0, 0, 1], surfaces: [zmin], dhat: 1.0e-4}
-  friction: {eps_v: 1.0e-3, regions: [{surface: zmin, mu: 0.3}]}
-dynamics: {scheme: implicit_euler, shear_viscosity: 50}
-solver: {end_time: 1.5, initial_step: 0.002, max_step: 0.01}
-output: {directory: whole, every: 10}
-]=])
+# The resume tests' sliding block (tests/app/scenes/slide.yaml), larger and run longer,
+# so that the kill comes well before the end.
+set(scene ${SCENE} --set geometry.lx=0.04 --set geometry.ly=0.04 --set geometry.mesh_size=0.005
+          --set solver.end_time=1.5 --set solver.max_step=0.01 --set output.every=10)
 set(mpi ${MPIEXEC} -n 2)
-execute_process(COMMAND ${mpi} ${MORPHFEM} run ${WORK}/slide.yaml --set output.directory=${WORK}/whole
+execute_process(COMMAND ${mpi} ${MORPHFEM} run ${scene} --set output.directory=${WORK}/whole
                 RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
 if(NOT rc EQUAL 0)
   message(FATAL_ERROR "uninterrupted run failed (${rc}):\n${out}\n${err}")
@@ -46,7 +36,7 @@ echo "killed with status $?"
 ]=])
 set(killed ${WORK}/killed)
 execute_process(COMMAND sh ${WORK}/start_and_kill.sh ${killed}.partial/checkpoint.h5 --
-                        ${mpi} ${MORPHFEM} run ${WORK}/slide.yaml --set output.directory=${killed}
+                        ${mpi} ${MORPHFEM} run ${scene} --set output.directory=${killed}
                         --set output.checkpoint_s=1e-9
                 RESULT_VARIABLE rc OUTPUT_VARIABLE out)
 if(NOT rc EQUAL 0)
@@ -57,12 +47,12 @@ if(EXISTS ${killed}/summary.json)
   message(FATAL_ERROR "the killed run had already finished")
 endif()
 
-execute_process(COMMAND ${MORPHFEM} run ${WORK}/slide.yaml --set output.directory=${killed} --resume
+execute_process(COMMAND ${MORPHFEM} run ${scene} --set output.directory=${killed} --resume
                 RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
 if(NOT rc EQUAL 2 OR NOT err MATCHES "mpirun -n 2")
   message(FATAL_ERROR "resuming on 1 rank gave exit ${rc}:\n${out}\n${err}")
 endif()
-execute_process(COMMAND ${mpi} ${MORPHFEM} run ${WORK}/slide.yaml --set output.directory=${killed} --resume
+execute_process(COMMAND ${mpi} ${MORPHFEM} run ${scene} --set output.directory=${killed} --resume
                 RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
 if(NOT rc EQUAL 0 OR NOT out MATCHES "resumed at t = ")
   message(FATAL_ERROR "resumed run failed (${rc}):\n${out}\n${err}")

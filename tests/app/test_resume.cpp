@@ -25,21 +25,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// Friction, contact and implicit-Euler inertia; steps grow from 2 ms to 20 ms.
-const char* kSlide = R"(
-name: slide
-geometry: {type: block, lx: 0.02, ly: 0.02, lz: 0.01, mesh_size: 0.01, order: 1}
-materials:
-  body: {model: neo_hookean, mu: 1.0e6, nu: 0.3, density: 1000}
-loads:
-  gravity: [4.38, 0, -8.77]
-contact:
-  ground: {point: [0, 0, -2.0e-5], normal: [0, 0, 1], surfaces: [zmin], dhat: 1.0e-4}
-  friction: {eps_v: 1.0e-3, regions: [{surface: zmin, mu: 0.3}]}
-dynamics: {scheme: implicit_euler, shear_viscosity: 50}
-solver: {end_time: 0.3, initial_step: 0.002, max_step: 0.02}
-output: {directory: OUT, every: 3, checkpoint_s: 0}
-)";
+// Friction, contact and implicit-Euler inertia (shared with kill_resume.cmake).
+const std::string kSlide = MORPHFEM_SOURCE_DIR "/tests/app/scenes/slide.yaml";
 
 // A gas cavity fed through a valve, BDF2 inertia with Kelvin-Voigt damping.
 const char* kBalloon = R"(
@@ -56,18 +43,19 @@ loads:
     - {name: bladder, surfaces: [inner], symmetry_factor: 8, supply_pressure: 5000, conductance: 1.7e-8}
 dynamics: {scheme: bdf2, shear_viscosity: 20}
 solver: {end_time: 0.4, initial_step: 0.01, max_step: 0.05}
-output: {directory: OUT, every: 2, checkpoint_s: 0}
+output: {directory: out, every: 2, checkpoint_s: 0}
 )";
 
 struct SceneFile {
   fs::path dir, out;
   YAML::Node doc;
-  SceneFile(const std::string& name, const std::string& text) {
+  // `source`: a scene's text, or (ending in .yaml) its file. Output goes to a fresh directory.
+  SceneFile(const std::string& name, const std::string& source) {
     dir = temp_dir("resume_" + name);
     out = dir / "out";
-    std::string t = text;
-    t.replace(t.find("OUT"), 3, out.string());
-    doc = YAML::Load(t);
+    doc =
+        source.size() > 5 && source.substr(source.size() - 5) == ".yaml" ? YAML::LoadFile(source) : YAML::Load(source);
+    doc["output"]["directory"] = out.string();
   }
   Scene scene(const std::string& set_end_time = "") const {
     YAML::Node d = YAML::Clone(doc);
@@ -113,7 +101,7 @@ std::vector<double> read_table(const fs::path& h5, const std::string& table, siz
 double max_abs_diff(const RowMatrixXd& a, const RowMatrixXd& b) { return (a - b).cwiseAbs().maxCoeff(); }
 
 // Uninterrupted run against one stopped after `stop` steps and resumed (twice if stop2 > 0).
-void expect_resume_matches(const std::string& name, const char* text, int stop, int stop2) {
+void expect_resume_matches(const std::string& name, const std::string& text, int stop, int stop2) {
   SceneFile whole(name + "_whole", text), parts(name + "_parts", text);
   const auto a = run_scene(whole.scene(), PETSC_COMM_WORLD, whole.options(false));
   ASSERT_TRUE(a.stats.completed) << a.stats.failure;
