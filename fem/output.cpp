@@ -265,8 +265,14 @@ ResultWriter::ResultWriter(const std::string& dir, const std::string& name, cons
         .close("H5Dclose /mesh/cells");
     if (have_regions_) {
       std::vector<hsize_t> rdims{static_cast<hsize_t>(n_cells_)};
-      write_dataset(file_, "/mesh/cell_region", H5T_STD_I32LE, H5T_NATIVE_INT, rdims, mesh.cell_region.data())
-          .close("H5Dclose /mesh/cell_region");
+      auto regions =
+          write_dataset(file_, "/mesh/cell_region", H5T_STD_I32LE, H5T_NATIVE_INT, rdims, mesh.cell_region.data());
+      // "names": "ID NAME" per volume region, so that scripts find a region by name.
+      std::vector<std::string> names;
+      for (const auto& r : mesh.regions)
+        if (r.dim == 3) names.push_back(std::to_string(r.id) + " " + r.name);
+      if (!names.empty()) write_string_attribute(regions.get(), "names", names, false);
+      regions.close("H5Dclose /mesh/cell_region");
     }
     check(H5Fflush(file_, H5F_SCOPE_GLOBAL), "H5Fflush " + h5_path_);
     write_xdmf();

@@ -3,7 +3,8 @@
 //
 //   DIR/NAME.h5    /mesh/X             n_nodes x 3  float64, reference coordinates [m]
 //                  /mesh/cells         n_cells x 4|10 int32, VTK node ordering
-//                  /mesh/cell_region   n_cells int32 (only if mesh.cell_region is complete)
+//                  /mesh/cell_region   n_cells int32 (only if mesh.cell_region is complete);
+//                                      attribute "names": "ID NAME" per volume region
 //                  /steps/NNNNNN/<f>   n x components float64 (n for scalars);
 //                                      group attribute "time"; dataset attribute "center"
 //                  /tables/<t>         rows x columns float64, attribute "columns"

@@ -7,7 +7,14 @@ vector of the mid-length cross-section (the nodes within 6 cm of mid-length and
 lies flat, negative when it has rolled towards +x. Used to tell rolling from
 rocking in the roll_flat diagnostics (README).
 
-    /usr/bin/python3 scripts/body_rotation.py RESULTS/CASE.h5 [T_FROM T_TO] [--every N]
+With --chambers it prints instead, per step, where each chamber (the volume regions
+named bladder_K, from the result's region names) is: its angle about the centroid of
+the mid-length band (0 = straight down, + towards +x) and the lowest point of its band
+above the ground [mm]; and the lowest point of each end of the body (the first and
+last 1.5 cm along y) [mm]. A push advances the rolling wave only if its chamber starts
+behind the contact (negative angle) and ends more than 45 deg behind it.
+
+    /usr/bin/python3 scripts/body_rotation.py RESULTS/CASE.h5 [T_FROM T_TO] [--every N] [--chambers]
 """
 import argparse
 import sys
@@ -22,6 +29,7 @@ def main():
     parser.add_argument("h5", help="the run's HDF5 file (its XDMF beside it gives the times)")
     parser.add_argument("window", nargs="*", type=float, help="optional time window [s]: from to")
     parser.add_argument("--every", type=int, default=3, help="print every N-th step outside a window")
+    parser.add_argument("--chambers", action="store_true", help="each chamber's angle and height, and the ends' height")
     args = parser.parse_args()
     if len(args.window) not in (0, 2):
         sys.exit("body_rotation.py: the time window needs two numbers (from to)")
@@ -33,6 +41,9 @@ def main():
     except (OSError, KeyError, ET.ParseError) as e:
         sys.exit(f"body_rotation.py: {args.h5}: not a morphfem result ({e})")
     y = X[:, 1]
+    if args.chambers:
+        chambers(args, f, X, steps, times)
+        return
     mid = np.abs(y - 0.5 * (y.min() + y.max())) < 0.06
     left = mid & (X[:, 0] < X[:, 0].min() + 0.011)
     right = mid & (X[:, 0] > X[:, 0].max() - 0.011)
@@ -46,6 +57,44 @@ def main():
         v = x[right].mean(0) - x[left].mean(0)
         angle = np.degrees(np.arctan2(v[2], v[0]))
         print(f"{t:9.2f}  {x[:, 0].mean():15.3f} {x[:, 2].mean():15.3f}  {angle:16.1f}  {np.linalg.norm(v):17.3f}")
+
+
+def chambers(args, f, X, steps, times):
+    """Per step: each chamber's angle and lowest point, and the lowest point of each end."""
+    region = f["/mesh/cell_region"]
+    if "names" not in region.attrs:
+        sys.exit(f"body_rotation.py: {args.h5}: no region names (written before they were stored); rerun the scene")
+    names = {}
+    for entry in region.attrs["names"]:
+        rid, name = (entry.decode() if isinstance(entry, bytes) else str(entry)).split(" ", 1)
+        names[name] = int(rid)
+    ids = sorted((int(n.split("_")[1]), i) for n, i in names.items() if n.startswith("bladder_") and n[8:].isdigit())
+    if not ids:
+        sys.exit(f"body_rotation.py: {args.h5}: no bladder_K regions")
+    cells, cell_region = f["/mesh/cells"][:], region[:]
+    y = X[:, 1]
+    band = np.abs(y - 0.5 * (y.min() + y.max())) < min(0.02, 0.5 * (y.max() - y.min()) + 1e-12)
+    nodes = {}
+    for k, rid in ids:
+        n = np.unique(cells[cell_region == rid].ravel())
+        nodes[k] = n[band[n]]
+    end_a, end_b = y < y.min() + 0.015, y > y.max() - 0.015
+    header = " ".join(f"  chamber {k}" for k, _ in ids)
+    print(f"    t [s]  {header}   end a  end b   (chamber: angle [deg] / lowest [mm]; ends: lowest [mm])")
+    for i, step in enumerate(steps):
+        t = times[i]
+        shown = args.window[0] <= t <= args.window[1] if args.window else i % args.every == 0
+        if not shown:
+            continue
+        x = X + f["/steps/" + step + "/displacement"][:]
+        centre = x[band].mean(0)
+        cols = []
+        for k, _ in ids:
+            p = x[nodes[k]]
+            m = p.mean(0) - centre
+            cols.append(f"{np.degrees(np.arctan2(m[0], -m[2])):5.0f}/{1000 * p[:, 2].min():5.1f}")
+        print(f"{t:9.2f}  " + " ".join(f"{c:>11}" for c in cols) +
+              f"  {1000 * x[end_a, 2].min():6.1f} {1000 * x[end_b, 2].min():6.1f}")
 
 
 if __name__ == "__main__":

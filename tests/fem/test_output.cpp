@@ -284,6 +284,13 @@ void check_three_steps(const std::string& dir, const std::string& name, const Me
   EXPECT_EQ(cells.dims,
             (std::vector<hsize_t>{static_cast<hsize_t>(mesh.n_cells()), static_cast<hsize_t>(mesh.nodes_per_cell())}));
   EXPECT_EQ(cells.values, std::vector<double>(mesh.cells.data(), mesh.cells.data() + mesh.cells.size()));
+  if (!mesh.cell_region.empty()) {  // region ids and names, so that scripts can find a region by name
+    H5Data region = read_dataset(f, "/mesh/cell_region");
+    EXPECT_EQ(region.values, std::vector<double>(mesh.cell_region.begin(), mesh.cell_region.end()));
+    std::vector<std::string> names;
+    for (const auto& r : mesh.regions) names.push_back(std::to_string(r.id) + " " + r.name);
+    EXPECT_EQ(read_string_attribute(f, "/mesh/cell_region", "names"), names);
+  }
   const double times[3] = {0.0, 0.1, 0.35};
   for (int s = 0; s < 3; ++s) {
     char group[32];
