@@ -1,9 +1,11 @@
 // gmsh model -> Mesh extraction (shared by the geometry builders and .msh import),
 // read_msh and write_msh.
 #include <gmsh.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <array>
+#include <csignal>
 #include <fstream>
 #include <map>
 #include <mutex>
@@ -294,6 +296,36 @@ ScopedGmshModel::ScopedGmshModel(const std::string& name) {
 
 ScopedGmshModel::~ScopedGmshModel() { gmsh::model::remove(); }
 
+namespace {
+// gmsh 4.8's boundary recovery (tetgen) can also fail an assert() and abort the process,
+// e.g. for the laminate whose 8 mm strip chambers end flush with the 5 mm end seals.
+// An abort cannot be caught: while the mesher runs, a SIGABRT handler writes a message
+// prepared beforehand (write(2) and _exit(2) are async-signal-safe) and exits with 2,
+// the exit code of bad input, instead of a core dump and a backtrace.
+std::string mesher_abort_message;
+extern "C" void report_mesher_abort(int) {
+  const ssize_t written = write(STDERR_FILENO, mesher_abort_message.data(), mesher_abort_message.size());
+  (void)written;
+  _exit(2);
+}
+class MesherAbortReport {
+ public:
+  explicit MesherAbortReport(const std::string& message) {
+    mesher_abort_message = "\nmorphfem: " + message + "\n";
+    struct sigaction action {};
+    action.sa_handler = report_mesher_abort;
+    sigemptyset(&action.sa_mask);
+    sigaction(SIGABRT, &action, &previous_);
+  }
+  ~MesherAbortReport() { sigaction(SIGABRT, &previous_, nullptr); }
+  MesherAbortReport(const MesherAbortReport&) = delete;
+  MesherAbortReport& operator=(const MesherAbortReport&) = delete;
+
+ private:
+  struct sigaction previous_ {};
+};
+}  // namespace
+
 void generate_tet_mesh(double mesh_size, int order, const std::string& where, const std::vector<VolumeSize>& refine) {
   gmsh::option::setNumber("Mesh.MeshSizeMin", 0.0);
   gmsh::option::setNumber("Mesh.MeshSizeMax", mesh_size);
@@ -332,6 +364,11 @@ void generate_tet_mesh(double mesh_size, int order, const std::string& where, co
     gmsh::model::add("morphfem_after_mesher_failure");
   };
   try {
+    std::ostringstream size;
+    size << mesh_size;
+    const MesherAbortReport report(where + ": gmsh aborted while meshing the geometry at mesh_size " + size.str() +
+                                   " m (an internal assertion, above); a slightly different mesh_size or "
+                                   "geometry usually meshes");
     gmsh::model::mesh::generate(3);
   } catch (const std::string& e) {
     restart();
