@@ -48,15 +48,18 @@ def main():
     left = mid & (X[:, 0] < X[:, 0].min() + 0.011)
     right = mid & (X[:, 0] > X[:, 0].max() - 0.011)
     print("    t [s]   centroid x [m]  centroid z [m]  seam angle [deg]  seam distance [m]")
-    for i, step in enumerate(steps):
-        t = times[i]
-        shown = args.window[0] <= t <= args.window[1] if args.window else i % args.every == 0
-        if not shown:
-            continue
-        x = X + f["/steps/" + step + "/displacement"][:]
+    for t, x in shown_steps(args, f, X, steps, times):
         v = x[right].mean(0) - x[left].mean(0)
         angle = np.degrees(np.arctan2(v[2], v[0]))
         print(f"{t:9.2f}  {x[:, 0].mean():15.3f} {x[:, 2].mean():15.3f}  {angle:16.1f}  {np.linalg.norm(v):17.3f}")
+
+
+def shown_steps(args, f, X, steps, times):
+    """(t, deformed coordinates) of each step in the window, or of every N-th step."""
+    for i, step in enumerate(steps):
+        t = times[i]
+        if args.window[0] <= t <= args.window[1] if args.window else i % args.every == 0:
+            yield t, X + f["/steps/" + step + "/displacement"][:]
 
 
 def chambers(args, f, X, steps, times):
@@ -81,12 +84,7 @@ def chambers(args, f, X, steps, times):
     end_a, end_b = y < y.min() + 0.015, y > y.max() - 0.015
     header = " ".join(f"  chamber {k}" for k, _ in ids)
     print(f"    t [s]  {header}   end a  end b   (chamber: angle [deg] / lowest [mm]; ends: lowest [mm])")
-    for i, step in enumerate(steps):
-        t = times[i]
-        shown = args.window[0] <= t <= args.window[1] if args.window else i % args.every == 0
-        if not shown:
-            continue
-        x = X + f["/steps/" + step + "/displacement"][:]
+    for t, x in shown_steps(args, f, X, steps, times):
         centre = x[band].mean(0)
         cols = []
         for k, _ in ids:
