@@ -10,8 +10,8 @@ rocking in the roll_flat diagnostics (README).
 With --chambers it prints instead, per step, where each chamber (the volume regions
 named bladder_K, from the result's region names) is: its angle about the centroid of
 the mid-length band (0 = straight down, + towards +x) and the lowest point of its band
-above the ground [mm]; and the lowest point of each end of the body (the first and
-last 1.5 cm along y) [mm]. A push advances the rolling wave only if its chamber starts
+above the ground [mm]; the lowest point of each end of the body (the first and last
+2.1 cm along y) [mm] and the ground's force on it [N]; and the whole ground force [N]. A push advances the rolling wave only if its chamber starts
 behind the contact (negative angle) and ends more than 45 deg behind it.
 
     /usr/bin/python3 scripts/body_rotation.py RESULTS/CASE.h5 [T_FROM T_TO] [--every N] [--chambers]
@@ -30,6 +30,8 @@ def main():
     parser.add_argument("window", nargs="*", type=float, help="optional time window [s]: from to")
     parser.add_argument("--every", type=int, default=3, help="print every N-th step outside a window")
     parser.add_argument("--chambers", action="store_true", help="each chamber's angle and height, and the ends' height")
+    parser.add_argument("--bladder-regions", help="region ids of bladders 1..K, comma-separated, for results "
+                        "written before region names were stored (e.g. 1,2,3,4,5,6,7,8 for the 3D physical preset)")
     args = parser.parse_args()
     if len(args.window) not in (0, 2):
         sys.exit("body_rotation.py: the time window needs two numbers (from to)")
@@ -62,15 +64,28 @@ def shown_steps(args, f, X, steps, times):
             yield t, X + f["/steps/" + step + "/displacement"][:]
 
 
+def force_z(f, step):
+    """Vertical ground contact force per node [N] (zeros if the step has none)."""
+    path = "/steps/" + step + "/contact_force_N"
+    if path not in f:
+        return np.zeros(f["/mesh/X"].shape[0])
+    force = f[path][:]
+    return force[:, 2] if force.ndim == 2 else force
+
+
 def chambers(args, f, X, steps, times):
     """Per step: each chamber's angle and lowest point, and the lowest point of each end."""
     region = f["/mesh/cell_region"]
-    if "names" not in region.attrs:
-        sys.exit(f"body_rotation.py: {args.h5}: no region names (written before they were stored); rerun the scene")
     names = {}
-    for entry in region.attrs["names"]:
-        rid, name = (entry.decode() if isinstance(entry, bytes) else str(entry)).split(" ", 1)
-        names[name] = int(rid)
+    if args.bladder_regions:
+        names = {f"bladder_{k + 1}": int(r) for k, r in enumerate(args.bladder_regions.split(","))}
+    elif "names" in region.attrs:
+        for entry in region.attrs["names"]:
+            rid, name = (entry.decode() if isinstance(entry, bytes) else str(entry)).split(" ", 1)
+            names[name] = int(rid)
+    else:
+        sys.exit(f"body_rotation.py: {args.h5}: no region names (written before they were stored); "
+                 "give --bladder-regions")
     ids = sorted((int(n.split("_")[1]), i) for n, i in names.items() if n.startswith("bladder_") and n[8:].isdigit())
     if not ids:
         sys.exit(f"body_rotation.py: {args.h5}: no bladder_K regions")
@@ -81,9 +96,11 @@ def chambers(args, f, X, steps, times):
     for k, rid in ids:
         n = np.unique(cells[cell_region == rid].ravel())
         nodes[k] = n[band[n]]
-    end_a, end_b = y < y.min() + 0.015, y > y.max() - 0.015
+    end_a, end_b = y < y.min() + 0.021, y > y.max() - 0.021
     header = " ".join(f"  chamber {k}" for k, _ in ids)
-    print(f"    t [s]  {header}   end a  end b   (chamber: angle [deg] / lowest [mm]; ends: lowest [mm])")
+    print(f"    t [s]  {header}        end a       end b   ground force [N]"
+          "   (chamber: angle [deg] / lowest [mm]; ends: lowest [mm] / ground force [N])")
+    t_step = dict(zip(times, steps))
     for t, x in shown_steps(args, f, X, steps, times):
         centre = x[band].mean(0)
         cols = []
@@ -91,8 +108,9 @@ def chambers(args, f, X, steps, times):
             p = x[nodes[k]]
             m = p.mean(0) - centre
             cols.append(f"{np.degrees(np.arctan2(m[0], -m[2])):5.0f}/{1000 * p[:, 2].min():5.1f}")
-        print(f"{t:9.2f}  " + " ".join(f"{c:>11}" for c in cols) +
-              f"  {1000 * x[end_a, 2].min():6.1f} {1000 * x[end_b, 2].min():6.1f}")
+        fz = force_z(f, t_step[t])
+        ends = " ".join(f"{1000 * x[e, 2].min():5.1f}/{fz[e].sum():5.2f}" for e in (end_a, end_b))
+        print(f"{t:9.2f}  " + " ".join(f"{c:>11}" for c in cols) + f"  {ends:>23}  {fz.sum():8.2f}")
 
 
 if __name__ == "__main__":
