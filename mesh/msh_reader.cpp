@@ -349,10 +349,11 @@ void generate_tet_mesh(double mesh_size, int order, const std::string& where, co
   // gmsh 4.8 throws std::string from inside its 3-D mesher for some sizes on thin
   // layers (e.g. "Could not recover boundary mesh: error 2" for the physical laminate
   // with foot pads at 7.5 mm).
+  std::ostringstream size_text;
+  size_text << mesh_size;
+  const std::string size = size_text.str();
   auto refuse = [&](const std::string& what) {
-    std::ostringstream size;
-    size << mesh_size;
-    throw InputError(where, "gmsh could not mesh the geometry at mesh_size " + size.str() + " m (gmsh: " + what +
+    throw InputError(where, "gmsh could not mesh the geometry at mesh_size " + size + " m (gmsh: " + what +
                                 "); a slightly different mesh_size usually meshes");
   };
   // A mesher that threw leaves gmsh's global state broken (the next model in the same
@@ -364,9 +365,7 @@ void generate_tet_mesh(double mesh_size, int order, const std::string& where, co
     gmsh::model::add("morphfem_after_mesher_failure");
   };
   try {
-    std::ostringstream size;
-    size << mesh_size;
-    const MesherAbortReport report(where + ": gmsh aborted while meshing the geometry at mesh_size " + size.str() +
+    const MesherAbortReport report(where + ": gmsh aborted while meshing the geometry at mesh_size " + size +
                                    " m (an internal assertion, above); a slightly different mesh_size or "
                                    "geometry usually meshes");
     gmsh::model::mesh::generate(3);
