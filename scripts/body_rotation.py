@@ -78,7 +78,10 @@ def chambers(args, f, X, steps, times):
     region = f["/mesh/cell_region"]
     names = {}
     if args.bladder_regions:
-        names = {f"bladder_{k + 1}": int(r) for k, r in enumerate(args.bladder_regions.split(","))}
+        try:
+            names = {f"bladder_{k + 1}": int(r) for k, r in enumerate(args.bladder_regions.split(","))}
+        except ValueError:
+            sys.exit(f"body_rotation.py: --bladder-regions {args.bladder_regions}: not comma-separated integers")
     elif "names" in region.attrs:
         for entry in region.attrs["names"]:
             rid, name = (entry.decode() if isinstance(entry, bytes) else str(entry)).split(" ", 1)
