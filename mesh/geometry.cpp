@@ -72,12 +72,14 @@ constexpr double kHuge = std::numeric_limits<double>::max();
 struct CommonParams {
   double mesh_size = 0.0;  // target edge length [m]
   int order = 1;
+  std::string where;  // the mesh_size key's location, for mesher errors
 };
 
 CommonParams common_params(const ParamSet& params) {
   CommonParams common;
   common.mesh_size = params.number_in("mesh_size", 1e-12, kHuge);
   common.order = params.integer_in("order", 1, 2, 1);
+  common.where = params.where("mesh_size");
   return common;
 }
 
@@ -130,7 +132,7 @@ Mesh box_mesh(const Eigen::Vector3d& lengths, const CommonParams& common, bool s
   gmsh::model::occ::addBox(0, 0, 0, lengths(0), lengths(1), lengths(2));
   gmsh::model::occ::synchronize();
   if (structured) make_box_transfinite(lengths, common.mesh_size);
-  generate_tet_mesh(common.mesh_size, common.order);
+  generate_tet_mesh(common.mesh_size, common.order, common.where);
   add_physical_groups(box_face_rules(lengths, names));
   return mesh_from_current_gmsh_model(source);
 }
@@ -250,7 +252,7 @@ Mesh build_thick_cylinder(const ParamSet& params) {
   occ::remove({{0, centre}});
   extrude_along_z(annulus, height, layers);
   occ::synchronize();
-  generate_tet_mesh(common.mesh_size, common.order);
+  generate_tet_mesh(common.mesh_size, common.order, common.where);
 
   const double tol = 1e-6 * r_out, r_mid = 0.5 * (r_in + r_out);
   add_physical_groups({{"zmin", [=](const NodeBox& b) { return b.max.z() < tol; }},
@@ -277,7 +279,7 @@ Mesh build_spherical_shell(const ParamSet& params) {
   const double box = 1.5 * r_out;
   occ::intersect(shell, {{3, occ::addBox(0, 0, 0, box, box, box)}}, octant, unused_map);
   occ::synchronize();
-  generate_tet_mesh(common.mesh_size, common.order);
+  generate_tet_mesh(common.mesh_size, common.order, common.where);
 
   const double tol = 1e-6 * r_out, r_mid = 0.5 * (r_in + r_out);
   add_physical_groups({{"sym_x", [=](const NodeBox& b) { return b.max.x() < tol; }},
@@ -310,7 +312,7 @@ Mesh build_cook_membrane(const ParamSet& params) {
     for (int edge : edges) gmsh::model::mesh::setTransfiniteCurve(edge, n + 1);
     gmsh::model::mesh::setTransfiniteSurface(trapezoid);
   }
-  generate_tet_mesh(common.mesh_size, common.order);
+  generate_tet_mesh(common.mesh_size, common.order, common.where);
 
   const double tol = 1e-6 * 60 * scale;
   add_physical_groups({{"zmin", [=](const NodeBox& bx) { return bx.max.z() < tol; }},

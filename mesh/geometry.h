@@ -64,14 +64,15 @@ void add_physical_groups(const std::vector<SurfaceRule>& rules);
 // Meshes the synchronized current model in 3-D: target size mesh_size [m] at every
 // CAD point (a background size field can only refine below it), element order 1 or 2
 // with curved mid-nodes, deterministic single-threaded Delaunay. A geometry gmsh cannot
-// mesh throws InputError(where, ...) with gmsh's reason. `refine` lists volumes (gmsh
+// mesh throws InputError(where, ...) with gmsh's reason; builders pass the location of
+// their mesh_size key (ParamSet::where: scene file, line, key). `refine` lists volumes (gmsh
 // tags) and a smaller size [m] for every CAD point on their boundaries (local
 // refinement: sizes are interpolated from the points along curves and surfaces).
 struct VolumeSize {
   std::vector<int> volumes;
   double size = 0.0;
 };
-void generate_tet_mesh(double mesh_size, int order, const std::string& where = "geometry",
+void generate_tet_mesh(double mesh_size, int order, const std::string& where,
                        const std::vector<VolumeSize>& refine = {});
 // A fresh gmsh model for one build or file operation, removed when the scope ends
 // (also on errors).
