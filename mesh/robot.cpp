@@ -438,8 +438,7 @@ Mesh build_robot_physical(const ParamSet& params) {
     }
     a.cavities.push_back({axis_box(x0 + w, x1 - w, y0 + we, y1 - we, z0 + w, z1 - w), name + "_wall"});
   }
-  return mesh_assembly(a, c.mesh_size, c.order,
-                       params.context().empty() ? "geometry robot_physical" : params.context(),
+  return mesh_assembly(a, c.mesh_size, c.order, params.context().empty() ? "geometry robot_physical" : params.context(),
                        params.where("mesh_size"));
 }
 

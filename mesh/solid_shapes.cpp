@@ -60,7 +60,8 @@ Mesh build_hemisphere(const ParamSet& params) {
     gmsh::model::mesh::field::setNumber(size, "DistMax", refine_radius + 2 * (mesh_size - contact_size));
     gmsh::model::mesh::field::setAsBackgroundMesh(size);
   }
-  generate_tet_mesh(mesh_size, order, params.where("mesh_size"));  // a background size field can only refine below mesh_size
+  generate_tet_mesh(mesh_size, order,
+                    params.where("mesh_size"));  // a background size field can only refine below mesh_size
 
   const double tol = 1e-6 * radius;
   std::vector<SurfaceRule> rules;
@@ -92,7 +93,8 @@ Mesh build_solid_cylinder(const ParamSet& params) {
     occ::cut({{3, outer}}, {{3, occ::addCylinder(0, -length, 0, 0, 3 * length, 0, inner_radius)}}, tube, unused_map);
   }
   occ::synchronize();
-  generate_tet_mesh(mesh_size, order, params.where("mesh_size"));  // a background size field can only refine below mesh_size
+  generate_tet_mesh(mesh_size, order,
+                    params.where("mesh_size"));  // a background size field can only refine below mesh_size
 
   const double tol = 1e-6 * std::max(radius, length), r_mid = 0.5 * (radius + inner_radius);
   std::vector<SurfaceRule> rules{{"ymin", [=](const NodeBox& b) { return b.max.y() < tol; }},
