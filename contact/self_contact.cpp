@@ -1,5 +1,6 @@
 #include "contact/self_contact.h"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -589,9 +590,32 @@ bool SelfContactTerm::refresh_pieces(const RowMatrixXd& U) {
     refresh(U);
     return true;
   }
-  double moved = 0.0;
-  for (int a : surface_nodes_) moved = std::max(moved, (U.row(a).transpose() - anchor_[a]).norm());
-  if (moved <= 0.25 * spec_.inflation) return false;
+  // Rigid re-anchoring. Every distance is invariant under one rigid motion Q of all
+  // nodes, so the candidates found at the anchor positions y are exactly those at Q y,
+  // and the trust region may be centred there. Q is the least-squares fit (Umeyama,
+  // no scaling) of y to the current positions x over the surface nodes; the
+  // candidates are kept while max |x - Q y| <= r/4 (or max |x - y| <= r/4, Q = I).
+  // A rolling or falling body then rebuilds them (and the assembly pattern) only when
+  // it deforms, not every time it moves.
+  const auto n = static_cast<Eigen::Index>(surface_nodes_.size());
+  Eigen::Matrix3Xd y(3, n), x(3, n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const int a = surface_nodes_[i];
+    y.col(i) = mesh_.X.row(a).transpose() + anchor_[a];
+    x.col(i) = mesh_.X.row(a).transpose() + U.row(a).transpose();
+  }
+  const double still = n > 0 ? (x - y).colwise().norm().maxCoeff() : 0.0;
+  if (still <= 0.25 * spec_.inflation) return false;
+  const Eigen::Matrix4d Q = Eigen::umeyama(y, x, false);
+  const Eigen::Matrix3Xd qy = (Q.topLeftCorner<3, 3>() * y).colwise() + Q.topRightCorner<3, 1>();
+  if ((x - qy).colwise().norm().maxCoeff() <= 0.25 * spec_.inflation) {
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const int a = surface_nodes_[i];
+      anchor_[a] = qy.col(i) - mesh_.X.row(a).transpose();
+    }
+    ++n_reanchors_;
+    return false;
+  }
   refresh(U);
   return true;
 }

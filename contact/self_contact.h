@@ -38,7 +38,10 @@
 // moving r/2 each change it by at most r). During a run refresh_pieces() (called
 // by the solver before each step with the converged state) rebuilds the candidates
 // once some surface node has used half of that trust radius (motion > r/4); the
-// solver then re-creates the assembly pattern.
+// solver then re-creates the assembly pattern. Motion is measured after removing the
+// best-fit rigid motion of the surface nodes (distances do not change under it; the
+// trust region moves with it), so a body that rolls or falls without deforming keeps
+// its candidates.
 //
 // max_step (conservative CCD): along u + alpha du the distance of a pair changes
 // by at most alpha L, L = max_i |du_i - du_p| over the triangle's vertices i (the
@@ -116,7 +119,8 @@ class SelfContactTerm : public EnergyTerm {
   double piece(int k, const PieceState& s, Eigen::VectorXd* g, Eigen::MatrixXd* H) const override;
   double max_step(Assembler& assembler, Vec u, Vec du) override;
   // Rebuilds the candidates at u0 once a surface node moved more than r/4 since
-  // the last refresh (returns true: the solver re-creates the pattern). Collective.
+  // the last refresh, rigid motion removed (returns true: the solver re-creates the
+  // pattern); otherwise moves the trust region with the rigid motion. Collective.
   bool refresh_pieces(Assembler& assembler, Vec u0) override;
   // Whether contact has started, and the displacement of the last candidate
   // search (the candidates are rebuilt from it on load).
@@ -139,6 +143,8 @@ class SelfContactTerm : public EnergyTerm {
   int n_pairs() const { return static_cast<int>(pairs_.size()); }
   int n_edge_pairs() const { return static_cast<int>(edge_pairs_.size()); }
   int n_refreshes() const { return n_refreshes_; }
+  // How often refresh_pieces moved the trust region rigidly instead of rebuilding.
+  int n_reanchors() const { return n_reanchors_; }
   // Smallest point-triangle / edge-edge distance over the candidate pairs [m] (collective).
   double min_distance(Assembler& assembler, Vec u) const;
   // Nodal forces and gaps of this rank's pairs at the whole displacement field u
@@ -181,6 +187,7 @@ class SelfContactTerm : public EnergyTerm {
   std::vector<int> surface_nodes_;       // every surface node
   std::vector<Eigen::Vector3d> anchor_;  // per mesh node: displacement at the last refresh [m]
   int n_refreshes_ = 0;
+  int n_reanchors_ = 0;
   bool active_ = true;
   double time_ = 0.0;  // the solver's current time [s] (set_time)
 };

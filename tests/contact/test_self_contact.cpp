@@ -330,6 +330,49 @@ TEST(SelfContactTerm, StartsAtItsStartTime) {
   EXPECT_FALSE(term.refresh_pieces(zero));  // nothing moved since
 }
 
+// A body that turns and moves without deforming keeps its candidates (no new
+// assembly pattern) and its trust region moves with it: a rolling robot would
+// otherwise rebuild every step and hit the trust region whenever a step moves it by
+// more than r/2. Deforming by more than r/4 still rebuilds.
+TEST(SelfContactTerm, RigidMotionMovesTheTrustRegionInsteadOfRebuilding) {
+  const Mesh mesh = thin_plate(1);
+  const Partition part = one_rank(mesh);
+  SelfContactSpec spec = across_the_plate();
+  spec.dhat = 3.5e-3;  // the 4 mm plate squeezed by 0.85 mm (< r/4) is inside the barrier
+  SelfContactTerm term(mesh, part, 0, spec);
+  const int pairs = term.n_pairs(), edge_pairs = term.n_edge_pairs();
+  RowMatrixXd squeeze = RowMatrixXd::Zero(mesh.n_nodes(), 3);
+  for (int a = 0; a < mesh.n_nodes(); ++a) squeeze(a, 2) = -0.85e-3 * mesh.X(a, 2) / 0.004;
+  const double e_squeezed = term_energy(term, mesh, squeeze);
+  ASSERT_GT(e_squeezed, 0.0);
+  ASSERT_TRUE(std::isfinite(e_squeezed));
+  // The same shape turned 50 deg about a tilted axis and moved 7 cm: 3-7 cm per node,
+  // far beyond r/2 = 2.25 mm.
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(50.0 * M_PI / 180.0, Eigen::Vector3d(1, 2, 3).normalized()).matrix();
+  const Eigen::RowVector3d t(0.05, -0.02, 0.045);
+  const auto moved = [&](const RowMatrixXd& u) {
+    RowMatrixXd out(mesh.n_nodes(), 3);
+    for (int a = 0; a < mesh.n_nodes(); ++a)
+      out.row(a) = (mesh.X.row(a) + u.row(a)) * R.transpose() + t - mesh.X.row(a);
+    return out;
+  };
+  EXPECT_EQ(term_energy(term, mesh, moved(RowMatrixXd::Zero(mesh.n_nodes(), 3))),
+            std::numeric_limits<double>::infinity());  // outside the trust region before re-anchoring
+  EXPECT_FALSE(term.refresh_pieces(moved(RowMatrixXd::Zero(mesh.n_nodes(), 3))));
+  EXPECT_EQ(term.n_reanchors(), 1);
+  EXPECT_EQ(term.n_refreshes(), 0);
+  EXPECT_EQ(term.n_pairs(), pairs);
+  EXPECT_EQ(term.n_edge_pairs(), edge_pairs);
+  EXPECT_EQ(term_energy(term, mesh, moved(RowMatrixXd::Zero(mesh.n_nodes(), 3))), 0.0);
+  EXPECT_NEAR(term_energy(term, mesh, moved(squeeze)), e_squeezed, 1e-9 * e_squeezed);
+  // Deforming by more than r/4 = 1.125 mm from the (moved) anchor rebuilds: squeezed
+  // by 3 mm, the faces are 1.5 mm from the best-fit rigid position (a translation).
+  RowMatrixXd crushed = squeeze;
+  for (int a = 0; a < mesh.n_nodes(); ++a) crushed(a, 2) = -3.0e-3 * mesh.X(a, 2) / 0.004;
+  EXPECT_TRUE(term.refresh_pieces(moved(crushed)));
+  EXPECT_EQ(term.n_refreshes(), 1);
+}
+
 TEST(SelfContactTerm, EdgePairsStopCrossingEdgesThatNoVertexSees) {
   const double gap = 2e-4;
   const Mesh mesh = crossing_wedges(gap / 1e-2);
