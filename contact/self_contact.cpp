@@ -330,6 +330,30 @@ Cell grid_cell(const Eigen::Vector3d& y, double size) {
           static_cast<long>(std::floor(y[2] / size))};
 }
 
+// The node sets of the surface pairs, merged where pairs share a node: the groups
+// whose candidates a rigid motion of the group's nodes leaves unchanged.
+template <class Sides>
+std::vector<std::vector<int>> rigid_groups(const Sides& sides) {
+  std::vector<std::set<int>> groups;
+  for (const auto& [a, b] : sides) {
+    std::set<int> nodes(a.points.begin(), a.points.end());
+    nodes.insert(b.points.begin(), b.points.end());
+    for (auto it = groups.begin(); it != groups.end();) {
+      const bool shares = std::any_of(it->begin(), it->end(), [&](int n) { return nodes.count(n) > 0; });
+      if (shares) {
+        nodes.insert(it->begin(), it->end());
+        it = groups.erase(it);
+      } else {
+        ++it;
+      }
+    }
+    groups.push_back(std::move(nodes));
+  }
+  std::vector<std::vector<int>> out;
+  for (const auto& g : groups) out.emplace_back(g.begin(), g.end());
+  return out;
+}
+
 }  // namespace
 
 SelfContactTerm::SelfContactTerm(const Mesh& mesh, const Partition& partition, int rank, SelfContactSpec spec)
@@ -364,6 +388,7 @@ SelfContactTerm::SelfContactTerm(const Mesh& mesh, const Partition& partition, i
   all_faces.erase(std::unique(all_faces.begin(), all_faces.end()), all_faces.end());
   weight_ = nodal_area_weights(mesh, all_faces);
   surface_nodes_.assign(surface_nodes.begin(), surface_nodes.end());
+  rigid_groups_ = rigid_groups(sides_);
   for (int a : surface_nodes_)
     if (a >= rank_begin_ && a < rank_end_) trust_nodes_.push_back(a);
   anchor_.assign(mesh.n_nodes(), Eigen::Vector3d::Zero());
@@ -590,34 +615,46 @@ bool SelfContactTerm::refresh_pieces(const RowMatrixXd& U) {
     refresh(U);
     return true;
   }
-  // Rigid re-anchoring. Every distance is invariant under one rigid motion Q of all
-  // nodes, so the candidates found at the anchor positions y are exactly those at Q y,
-  // and the trust region may be centred there. Q is the least-squares fit (Umeyama,
-  // no scaling) of y to the current positions x over the surface nodes; the
-  // candidates are kept while max |x - Q y| <= r/4 (or max |x - y| <= r/4, Q = I).
-  // A rolling or falling body then rebuilds them (and the assembly pattern) only when
-  // it deforms, not every time it moves.
-  const auto n = static_cast<Eigen::Index>(surface_nodes_.size());
-  Eigen::Matrix3Xd y(3, n), x(3, n);
-  for (Eigen::Index i = 0; i < n; ++i) {
-    const int a = surface_nodes_[i];
-    y.col(i) = mesh_.X.row(a).transpose() + anchor_[a];
-    x.col(i) = mesh_.X.row(a).transpose() + U.row(a).transpose();
-  }
-  const double still = n > 0 ? (x - y).colwise().norm().maxCoeff() : 0.0;
-  if (still <= 0.25 * spec_.inflation) return false;
-  const Eigen::Matrix4d Q = Eigen::umeyama(y, x, false);
-  const Eigen::Matrix3Xd qy = (Q.topLeftCorner<3, 3>() * y).colwise() + Q.topRightCorner<3, 1>();
-  if ((x - qy).colwise().norm().maxCoeff() <= 0.25 * spec_.inflation) {
+  // Rigid re-anchoring. A pair's distance is invariant under a rigid motion of its
+  // nodes, so the candidates of the surface pairs of a group (pairs that share no node
+  // with other groups, e.g. one chamber's walls) found at anchor positions y are
+  // exactly those at Q y, and the group's trust region may be centred there. Q is the
+  // least-squares fit (Umeyama, no scaling) of y to the current positions x over the
+  // group's nodes; the candidates are kept while max |x - Q y| <= r/4 in every group.
+  // A body that rolls, falls or curls without deforming its contact surfaces then
+  // rebuilds them (and the assembly pattern) only when they deform.
+  const double limit = 0.25 * spec_.inflation;
+  std::vector<Eigen::Matrix3Xd> fitted;
+  bool moved = false;
+  for (const std::vector<int>& group : rigid_groups_) {
+    const auto n = static_cast<Eigen::Index>(group.size());
+    Eigen::Matrix3Xd y(3, n), x(3, n);
     for (Eigen::Index i = 0; i < n; ++i) {
-      const int a = surface_nodes_[i];
-      anchor_[a] = qy.col(i) - mesh_.X.row(a).transpose();
+      const int a = group[i];
+      y.col(i) = mesh_.X.row(a).transpose() + anchor_[a];
+      x.col(i) = mesh_.X.row(a).transpose() + U.row(a).transpose();
     }
-    ++n_reanchors_;
-    return false;
+    if ((x - y).colwise().norm().maxCoeff() <= limit) {
+      fitted.push_back(std::move(y));  // Q = I
+      continue;
+    }
+    moved = true;
+    const Eigen::Matrix4d Q = Eigen::umeyama(y, x, false);
+    fitted.emplace_back((Q.topLeftCorner<3, 3>() * y).colwise() + Q.topRightCorner<3, 1>());
+    if ((x - fitted.back()).colwise().norm().maxCoeff() > limit) {
+      refresh(U);
+      return true;
+    }
   }
-  refresh(U);
-  return true;
+  if (moved) {
+    for (size_t g = 0; g < rigid_groups_.size(); ++g)
+      for (size_t i = 0; i < rigid_groups_[g].size(); ++i) {
+        const int a = rigid_groups_[g][i];
+        anchor_[a] = fitted[g].col(static_cast<Eigen::Index>(i)) - mesh_.X.row(a).transpose();
+      }
+    ++n_reanchors_;
+  }
+  return false;
 }
 
 void SelfContactTerm::refresh(Assembler& assembler, Vec u) { refresh(assembler.gather_all(u)); }

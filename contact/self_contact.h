@@ -39,9 +39,10 @@
 // by the solver before each step with the converged state) rebuilds the candidates
 // once some surface node has used half of that trust radius (motion > r/4); the
 // solver then re-creates the assembly pattern. Motion is measured after removing the
-// best-fit rigid motion of the surface nodes (distances do not change under it; the
-// trust region moves with it), so a body that rolls or falls without deforming keeps
-// its candidates.
+// best-fit rigid motion of each group of surface pairs that share nodes (e.g. one
+// chamber's walls): distances do not change under it, and the trust region moves with
+// it, so a body that rolls, falls or curls without deforming its contact surfaces
+// keeps its candidates.
 //
 // max_step (conservative CCD): along u + alpha du the distance of a pair changes
 // by at most alpha L, L = max_i |du_i - du_p| over the triangle's vertices i (the
@@ -181,11 +182,12 @@ class SelfContactTerm : public EnergyTerm {
     std::vector<double> edge_weight;           // A_e [m^2]
   };
   std::vector<std::pair<Side, Side>> sides_;
-  std::vector<Pair> pairs_;              // owned pairs (owner of the point)
-  std::vector<EdgePair> edge_pairs_;     // owned edge pairs (owner of the smallest node)
-  std::vector<int> trust_nodes_;         // owned surface nodes
-  std::vector<int> surface_nodes_;       // every surface node
-  std::vector<Eigen::Vector3d> anchor_;  // per mesh node: displacement at the last refresh [m]
+  std::vector<Pair> pairs_;                     // owned pairs (owner of the point)
+  std::vector<EdgePair> edge_pairs_;            // owned edge pairs (owner of the smallest node)
+  std::vector<int> trust_nodes_;                // owned surface nodes
+  std::vector<int> surface_nodes_;              // every surface node
+  std::vector<std::vector<int>> rigid_groups_;  // surface nodes of pairs sharing nodes, merged
+  std::vector<Eigen::Vector3d> anchor_;         // per mesh node: displacement at the last refresh [m]
   int n_refreshes_ = 0;
   int n_reanchors_ = 0;
   bool active_ = true;

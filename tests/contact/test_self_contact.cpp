@@ -373,6 +373,29 @@ TEST(SelfContactTerm, RigidMotionMovesTheTrustRegionInsteadOfRebuilding) {
   EXPECT_EQ(term.n_refreshes(), 1);
 }
 
+// Surface pairs that share no node (two chambers) are fitted separately: each may
+// turn its own way (a curling laminate turns its chambers by different angles). One
+// fit over both would leave centimetres of misfit and rebuild.
+TEST(SelfContactTerm, PairsWithoutCommonNodesMoveTheirTrustRegionsSeparately) {
+  const Mesh mesh = thin_plate(1);
+  const Partition part = one_rank(mesh);
+  SelfContactSpec spec = across_the_plate();
+  spec.pairs = {{"xmin", "xmin"}, {"xmax", "xmax"}};  // the two end faces: no common node
+  SelfContactTerm term(mesh, part, 0, spec);
+  const std::vector<int> xmin = mesh.nodes_of_surface("xmin"), xmax = mesh.nodes_of_surface("xmax");
+  const Eigen::Matrix3d Ra = Eigen::AngleAxisd(0.6, Eigen::Vector3d::UnitZ()).matrix();
+  const Eigen::Matrix3d Rb = Eigen::AngleAxisd(-0.9, Eigen::Vector3d(1, 1, 0).normalized()).matrix();
+  RowMatrixXd u = RowMatrixXd::Zero(mesh.n_nodes(), 3);
+  for (int a : xmin) u.row(a) = mesh.X.row(a) * Ra.transpose() + Eigen::RowVector3d(0.01, 0, 0) - mesh.X.row(a);
+  for (int a : xmax) u.row(a) = mesh.X.row(a) * Rb.transpose() + Eigen::RowVector3d(0, 0.03, 0) - mesh.X.row(a);
+  EXPECT_FALSE(term.refresh_pieces(u));
+  EXPECT_EQ(term.n_reanchors(), 1);
+  EXPECT_EQ(term_energy(term, mesh, u), 0.0);  // both trust regions moved with their faces
+  // One face bent by 2 mm > r/4 at one node: rebuild.
+  u(xmax.front(), 2) += 2e-3;
+  EXPECT_TRUE(term.refresh_pieces(u));
+}
+
 TEST(SelfContactTerm, EdgePairsStopCrossingEdgesThatNoVertexSees) {
   const double gap = 2e-4;
   const Mesh mesh = crossing_wedges(gap / 1e-2);
