@@ -686,7 +686,12 @@ SimulationResult run_scene(const Scene& scene, MPI_Comm comm, const RunOptions& 
           .add("resumed_at_s", result.resumed_at)
           .add("min_J", result.min_J)
           .add("mass_kg", result.mass_kg)
-          .add("max_displacement_m", result.u.rowwise().norm().maxCoeff());
+          .add("max_displacement_m", result.u.rowwise().norm().maxCoeff())
+          .add("pattern_rebuilds", solver.pattern_rebuilds());
+      if (self_contact)  // candidate searches, and rigid moves of the trust region instead of one
+        summary.add(
+            "self_contact",
+            Json().add("refreshes", self_contact->n_refreshes()).add("rigid_reanchors", self_contact->n_reanchors()));
       std::vector<Json> cavs;
       for (size_t i = 0; i < result.cavity_names.size(); ++i) {
         Json c;

@@ -662,6 +662,7 @@ void SelfContactTerm::refresh(Assembler& assembler, Vec u) { refresh(assembler.g
 void SelfContactTerm::save_state(Assembler& assembler, const std::string& prefix, StateRecord& state) {
   state.integers[prefix + ".active"] = active_;
   state.integers[prefix + ".refreshes"] = n_refreshes_;
+  state.integers[prefix + ".reanchors"] = n_reanchors_;
   if (assembler.rank() != 0) return;
   std::vector<double> anchor(3 * anchor_.size());
   for (size_t a = 0; a < anchor_.size(); ++a)
@@ -683,6 +684,7 @@ void SelfContactTerm::load_state(Assembler&, const std::string& prefix, const St
     edge_pairs_.clear();
   }
   n_refreshes_ = static_cast<int>(state.integer(prefix + ".refreshes", where));
+  n_reanchors_ = static_cast<int>(state.integer(prefix + ".reanchors", where));
 }
 
 void SelfContactTerm::refresh(const RowMatrixXd& u) {
