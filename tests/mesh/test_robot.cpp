@@ -224,10 +224,9 @@ TEST(RobotGeometry, MesherFailureIsAnInputError) {
 // not with a core dump. The child exits with 3 if this gmsh meshes the geometry.
 TEST(RobotGeometryDeathTest, MesherAbortIsReportedAndExitsWith2) {
   GTEST_FLAG_SET(death_test_style, "threadsafe");
-  auto params = robot_params("robot_physical", {{"bladder_mesh_size", 0.008},
-                                                {"bladder_wall", 0.0012},
-                                                {"bladder_bond_width", 0.004},
-                                                {"foot_length", 0.005}});
+  auto params = robot_params(
+      "robot_physical",
+      {{"bladder_mesh_size", 0.008}, {"bladder_wall", 0.0012}, {"bladder_bond_width", 0.004}, {"foot_length", 0.005}});
   params.set_string("fabric", "membrane");
   params.set("mesh_size", 0.019, "robot.yaml:4:14");
   const auto exited_2_or_3 = [](int status) {
