@@ -392,6 +392,7 @@ SelfContactTerm::SelfContactTerm(const Mesh& mesh, const Partition& partition, i
   for (int a : surface_nodes_)
     if (a >= rank_begin_ && a < rank_end_) trust_nodes_.push_back(a);
   anchor_.assign(mesh.n_nodes(), Eigen::Vector3d::Zero());
+  searched_ = anchor_;
   build_candidates(mesh.X);
   const RowMatrixXd zero = RowMatrixXd::Zero(mesh.n_nodes(), 3);
   for (const Pair& pr : pairs_)
@@ -664,31 +665,38 @@ void SelfContactTerm::save_state(Assembler& assembler, const std::string& prefix
   state.integers[prefix + ".refreshes"] = n_refreshes_;
   state.integers[prefix + ".reanchors"] = n_reanchors_;
   if (assembler.rank() != 0) return;
-  std::vector<double> anchor(3 * anchor_.size());
-  for (size_t a = 0; a < anchor_.size(); ++a)
-    for (int i = 0; i < 3; ++i) anchor[3 * a + i] = anchor_[a][i];
-  state.arrays[prefix + ".anchor"] = std::move(anchor);
+  for (const auto& [key, field] : {std::pair{".anchor", &anchor_}, std::pair{".searched", &searched_}}) {
+    std::vector<double> flat(3 * field->size());
+    for (size_t a = 0; a < field->size(); ++a)
+      for (int i = 0; i < 3; ++i) flat[3 * a + i] = (*field)[a][i];
+    state.arrays[prefix + key] = std::move(flat);
+  }
 }
 
 void SelfContactTerm::load_state(Assembler&, const std::string& prefix, const StateRecord& state) {
   const std::string where = "checkpoint: " + prefix;
   active_ = state.integer(prefix + ".active", where) != 0;
-  const auto& anchor = state.array(prefix + ".anchor", where, 3L * mesh_.n_nodes());
-  RowMatrixXd U(mesh_.n_nodes(), 3);
-  for (int a = 0; a < mesh_.n_nodes(); ++a)
-    for (int i = 0; i < 3; ++i) U(a, i) = anchor[3 * a + i];
+  const auto field = [&](const char* key) {
+    const auto& flat = state.array(prefix + key, where, 3L * mesh_.n_nodes());
+    RowMatrixXd U(mesh_.n_nodes(), 3);
+    for (int a = 0; a < mesh_.n_nodes(); ++a)
+      for (int i = 0; i < 3; ++i) U(a, i) = flat[3 * a + i];
+    return U;
+  };
+  const RowMatrixXd anchor = field(".anchor"), searched = field(".searched");
   if (active_) {
-    refresh(U);  // the candidates of the last search, from the same positions
+    refresh(searched);  // the candidates of the last search, from the same positions
   } else {
     pairs_.clear();
     edge_pairs_.clear();
   }
+  for (int a = 0; a < mesh_.n_nodes(); ++a) anchor_[a] = anchor.row(a).transpose();  // moved rigidly since
   n_refreshes_ = static_cast<int>(state.integer(prefix + ".refreshes", where));
   n_reanchors_ = static_cast<int>(state.integer(prefix + ".reanchors", where));
 }
 
 void SelfContactTerm::refresh(const RowMatrixXd& u) {
-  for (int a = 0; a < mesh_.n_nodes(); ++a) anchor_[a] = u.row(a).transpose();
+  for (int a = 0; a < mesh_.n_nodes(); ++a) anchor_[a] = searched_[a] = u.row(a).transpose();
   build_candidates(mesh_.X + u);
   ++n_refreshes_;
 }

@@ -123,8 +123,8 @@ class SelfContactTerm : public EnergyTerm {
   // the last refresh, rigid motion removed (returns true: the solver re-creates the
   // pattern); otherwise moves the trust region with the rigid motion. Collective.
   bool refresh_pieces(Assembler& assembler, Vec u0) override;
-  // Whether contact has started, and the displacement of the last candidate
-  // search (the candidates are rebuilt from it on load).
+  // Whether contact has started, the displacement of the last candidate search (the
+  // candidates are rebuilt from it on load) and the trust-region centre.
   void save_state(Assembler& assembler, const std::string& prefix, StateRecord& state) override;
   void load_state(Assembler& assembler, const std::string& prefix, const StateRecord& state) override;
   // The same decision from the whole displacement field (identical on every rank);
@@ -187,7 +187,11 @@ class SelfContactTerm : public EnergyTerm {
   std::vector<int> trust_nodes_;                // owned surface nodes
   std::vector<int> surface_nodes_;              // every surface node
   std::vector<std::vector<int>> rigid_groups_;  // surface nodes of pairs sharing nodes, merged
-  std::vector<Eigen::Vector3d> anchor_;         // per mesh node: displacement at the last refresh [m]
+  std::vector<Eigen::Vector3d> anchor_;         // per mesh node: trust-region centre (displacement) [m]
+  // Per mesh node: displacement at the last candidate search [m]; the anchor is this
+  // moved rigidly. Checkpoints keep both, so a resumed run searches from the same
+  // positions and finds the same candidates in the same order.
+  std::vector<Eigen::Vector3d> searched_;
   int n_refreshes_ = 0;
   int n_reanchors_ = 0;
   bool active_ = true;

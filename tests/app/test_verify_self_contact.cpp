@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 #include <petscvec.h>
 
+#include <Eigen/Geometry>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -16,6 +17,7 @@
 #include "app/verify_self_contact.h"
 #include "contact/self_contact.h"
 #include "core/errors.h"
+#include "core/state_file.h"
 #include "fem/assembly.h"
 #include "mesh/geometry.h"
 #include "mesh/partition.h"
@@ -81,6 +83,59 @@ TEST(SelfContactRefresh, RebuildsCandidatesOnceMotionUsesHalfTheTrustRadius) {
   EXPECT_NO_THROW(assembler.hessian(u, H));  // every new pair fits the new pattern
   MatDestroy(&H);
   EXPECT_FALSE(term->refresh_pieces(assembler, u));  // no motion since the refresh
+  VecDestroy(&u);
+}
+
+// A checkpoint keeps where the candidates were searched and the trust region's centre
+// after rigid moves: the restored term has the same pairs, in the same order, and the
+// same energy (so a resumed run takes the same steps), and its trust region is where
+// the saved one had moved, not where the search was.
+TEST(SelfContactRefresh, CheckpointKeepsTheSearchAndTheRigidlyMovedTrustRegion) {
+  Mesh mesh = plate();
+  const Partition part = partition_mesh(mesh, 1);
+  SelfContactSpec spec;
+  spec.pairs = {{"zmin", "zmax"}};
+  spec.dhat = 2e-4;
+  spec.kappa = 1e6;
+  spec.inflation = 3e-3;
+  auto term = std::make_shared<SelfContactTerm>(mesh, part, 0, spec);
+  Assembler assembler(mesh, part, PETSC_COMM_WORLD);
+  assembler.add_term(term);
+  assembler.setup();
+  Vec u = assembler.create_vector();
+  // Squeezed 3.85 mm (zmax 0.15 mm above zmin: in the barrier), then turned 30 deg and moved 2 cm.
+  RowMatrixXd field = RowMatrixXd::Zero(mesh.n_nodes(), 3);
+  for (int n : mesh.nodes_of_surface("zmax")) field(n, 2) = -3.85e-3;
+  assembler.scatter_all(field, u);
+  ASSERT_TRUE(term->refresh_pieces(assembler, u));
+  ASSERT_GT(term->n_pairs(), 0);
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(M_PI / 6, Eigen::Vector3d(0, 1, 1).normalized()).matrix();
+  for (int n = 0; n < mesh.n_nodes(); ++n)
+    field.row(n) = (mesh.X.row(n) + field.row(n)) * R.transpose() + Eigen::RowVector3d(0.02, 0, 0) - mesh.X.row(n);
+  assembler.scatter_all(field, u);
+  ASSERT_FALSE(term->refresh_pieces(assembler, u));
+  ASSERT_EQ(term->n_reanchors(), 1);
+  const double energy = assembler.energy(u);
+  ASSERT_TRUE(std::isfinite(energy) && energy > 0);
+
+  StateRecord state;
+  term->save_state(assembler, "self", state);
+  auto restored = std::make_shared<SelfContactTerm>(mesh, part, 0, spec);
+  Assembler other(mesh, part, PETSC_COMM_WORLD);
+  other.add_term(restored);
+  restored->load_state(other, "self", state);
+  other.setup();
+  EXPECT_EQ(restored->n_pairs(), term->n_pairs());
+  EXPECT_EQ(restored->n_edge_pairs(), term->n_edge_pairs());
+  EXPECT_EQ(restored->n_refreshes(), term->n_refreshes());
+  EXPECT_EQ(restored->n_reanchors(), 1);
+  std::vector<int> a, b;
+  for (int k = 0; k < term->n_pieces(); ++k) {
+    term->piece_nodes(k, a);
+    restored->piece_nodes(k, b);
+    ASSERT_EQ(a, b) << k;
+  }
+  EXPECT_EQ(other.energy(u), energy);  // finite: the restored trust region moved too
   VecDestroy(&u);
 }
 
