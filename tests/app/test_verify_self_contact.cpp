@@ -37,6 +37,17 @@ Mesh plate() {
   return build_geometry(p);
 }
 
+// The plate's faces as one contact pair: barrier 0.2 mm, candidate reach 3.2 mm < 4 mm
+// (no pairs at the start).
+SelfContactSpec across_the_plate() {
+  SelfContactSpec spec;
+  spec.pairs = {{"zmin", "zmax"}};
+  spec.dhat = 2e-4;
+  spec.kappa = 1e6;
+  spec.inflation = 3e-3;
+  return spec;
+}
+
 std::string write_scene(const std::string& name, const std::string& text) {
   const std::string path = (std::filesystem::temp_directory_path() / name).string();
   std::ofstream(path) << text;
@@ -51,11 +62,7 @@ std::string write_scene(const std::string& name, const std::string& text) {
 TEST(SelfContactRefresh, RebuildsCandidatesOnceMotionUsesHalfTheTrustRadius) {
   Mesh mesh = plate();
   const Partition part = partition_mesh(mesh, 1);
-  SelfContactSpec spec;
-  spec.pairs = {{"zmin", "zmax"}};
-  spec.dhat = 2e-4;
-  spec.kappa = 1e6;
-  spec.inflation = 3e-3;  // reach 3.2 mm < 4 mm: no pairs at the start
+  const SelfContactSpec spec = across_the_plate();
   auto term = std::make_shared<SelfContactTerm>(mesh, part, 0, spec);
   EXPECT_EQ(term->n_pairs() + term->n_edge_pairs(), 0);
   Assembler assembler(mesh, part, PETSC_COMM_WORLD);
@@ -93,11 +100,7 @@ TEST(SelfContactRefresh, RebuildsCandidatesOnceMotionUsesHalfTheTrustRadius) {
 TEST(SelfContactRefresh, CheckpointKeepsTheSearchAndTheRigidlyMovedTrustRegion) {
   Mesh mesh = plate();
   const Partition part = partition_mesh(mesh, 1);
-  SelfContactSpec spec;
-  spec.pairs = {{"zmin", "zmax"}};
-  spec.dhat = 2e-4;
-  spec.kappa = 1e6;
-  spec.inflation = 3e-3;
+  const SelfContactSpec spec = across_the_plate();
   auto term = std::make_shared<SelfContactTerm>(mesh, part, 0, spec);
   Assembler assembler(mesh, part, PETSC_COMM_WORLD);
   assembler.add_term(term);
