@@ -129,10 +129,11 @@ void name_gap_faces(Mesh& mesh, const std::vector<Cavity>& gaps, double tol) {
   }
 }
 
-// `source` names the model in mesh errors; `mesher_where` (the mesh_size key's location)
-// names it when gmsh cannot mesh it.
-Mesh mesh_assembly(const Assembly& assembly, double mesh_size, int order, const std::string& source,
-                   const std::string& mesher_where) {
+// Mesh errors name the scene's geometry (or "geometry TYPE"); a geometry gmsh cannot
+// mesh names the mesh_size key's location.
+Mesh mesh_assembly(const Assembly& assembly, double mesh_size, int order, const ParamSet& params,
+                   const std::string& type) {
+  const std::string source = params.context().empty() ? "geometry " + type : params.context();
   ScopedGmshModel model("morphfem_robot");
   namespace occ = gmsh::model::occ;
   gmsh::vectorpair boxes;
@@ -167,7 +168,7 @@ Mesh mesh_assembly(const Assembly& assembly, double mesh_size, int order, const 
     for (const auto& [tag, region] : region_of_volume)
       if (region.rfind("bladder_", 0) == 0) refine.back().volumes.push_back(tag);
   }
-  generate_tet_mesh(mesh_size, order, mesher_where, refine);
+  generate_tet_mesh(mesh_size, order, params.where("mesh_size"), refine);
   for (const std::string& name : assembly.volume_order) add_group(3, volume_tags[name], name);
 
   // Boundary surfaces (one adjacent volume).
@@ -337,8 +338,7 @@ Mesh build_robot_voxel(const ParamSet& params) {
     const double z0 = k <= 4 ? z_upper : 0.0;
     a.pieces.push_back({axis_box(x0, x1, y0, y1, z0, z0 + hb), bladder_name(k)});
   }
-  return mesh_assembly(a, c.mesh_size, c.order, params.context().empty() ? "geometry robot_voxel" : params.context(),
-                       params.where("mesh_size"));
+  return mesh_assembly(a, c.mesh_size, c.order, params, "robot_voxel");
 }
 
 Mesh build_robot_physical(const ParamSet& params) {
@@ -438,8 +438,7 @@ Mesh build_robot_physical(const ParamSet& params) {
     }
     a.cavities.push_back({axis_box(x0 + w, x1 - w, y0 + we, y1 - we, z0 + w, z1 - w), name + "_wall"});
   }
-  return mesh_assembly(a, c.mesh_size, c.order, params.context().empty() ? "geometry robot_physical" : params.context(),
-                       params.where("mesh_size"));
+  return mesh_assembly(a, c.mesh_size, c.order, params, "robot_physical");
 }
 
 }  // namespace morphfem
