@@ -206,7 +206,7 @@ Mesh build_block(const ParamSet& params) {
   const bool structured = params.integer_in("structured", 0, 1, 0) == 1;
   const double distort = params.number_in("distort", 0.0, 0.3, 0.0);
   Mesh mesh = box_mesh(lengths, common, structured, {"xmin", "xmax", "ymin", "ymax", "zmin", "zmax"},
-                       params.context().empty() ? "geometry block" : params.context());
+                       geometry_source(params, "block"));
   if (distort > 0.0) {
     distort_interior_vertices(mesh, distort * common.mesh_size);
     validate_mesh(mesh, "geometry block (distorted)");
@@ -221,7 +221,7 @@ Mesh build_cantilever(const ParamSet& params) {
                                 positive_length(params, "h"));
   const bool structured = params.integer_in("structured", 0, 1, 0) == 1;
   return box_mesh(lengths, common, structured, {"root", "tip", "ymin", "ymax", "zmin", "zmax"},
-                  params.context().empty() ? "geometry cantilever" : params.context());
+                  geometry_source(params, "cantilever"));
 }
 
 // Extrudes planar surface `surface` (in z = 0) by `height` along z: `layers` structured
@@ -261,7 +261,7 @@ Mesh build_thick_cylinder(const ParamSet& params) {
                        {"sym_y", [=](const NodeBox& b) { return b.max.y() < tol; }},
                        {"inner", [=](const NodeBox& b) { return std::max(b.max.x(), b.max.y()) < r_mid; }},
                        {"outer", [=](const NodeBox& b) { return true; }}});
-  return mesh_from_current_gmsh_model(params.context().empty() ? "geometry thick_cylinder" : params.context());
+  return mesh_from_current_gmsh_model(geometry_source(params, "thick_cylinder"));
 }
 
 Mesh build_spherical_shell(const ParamSet& params) {
@@ -287,7 +287,7 @@ Mesh build_spherical_shell(const ParamSet& params) {
                        {"sym_z", [=](const NodeBox& b) { return b.max.z() < tol; }},
                        {"inner", [=](const NodeBox& b) { return b.max.maxCoeff() < r_mid; }},
                        {"outer", [=](const NodeBox& b) { return true; }}});
-  return mesh_from_current_gmsh_model(params.context().empty() ? "geometry spherical_shell" : params.context());
+  return mesh_from_current_gmsh_model(geometry_source(params, "spherical_shell"));
 }
 
 Mesh build_cook_membrane(const ParamSet& params) {
@@ -321,7 +321,7 @@ Mesh build_cook_membrane(const ParamSet& params) {
                        {"right", [=](const NodeBox& bx) { return bx.min.x() > 48 * scale - tol; }},
                        {"bottom", [=](const NodeBox& bx) { return bx.min.y() < tol; }},
                        {"top", [=](const NodeBox& bx) { return bx.max.y() > 60 * scale - tol; }}});
-  return mesh_from_current_gmsh_model(params.context().empty() ? "geometry cook_membrane" : params.context());
+  return mesh_from_current_gmsh_model(geometry_source(params, "cook_membrane"));
 }
 
 }  // namespace
@@ -339,6 +339,10 @@ const std::map<std::string, GeometryBuilder>& geometry_registry() {
       {"solid_cylinder", build_solid_cylinder},
   };
   return registry;
+}
+
+std::string geometry_source(const ParamSet& params, const std::string& type) {
+  return params.context().empty() ? "geometry " + type : params.context();
 }
 
 Mesh build_geometry(const ParamSet& params) {

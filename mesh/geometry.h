@@ -29,6 +29,10 @@ const std::map<std::string, GeometryBuilder>& geometry_registry();
 // or bad parameter.
 Mesh build_geometry(const ParamSet& params);
 
+// What a builder's mesh errors name: the scene's geometry section (its file and
+// line) or, for a ParamSet made in code, "geometry TYPE".
+std::string geometry_source(const ParamSet& params, const std::string& type);
+
 // Reads a gmsh .msh (format 4.x) file: 4- or 10-node tetrahedra, physical groups
 // of dimension 3 (materials) and 2 (surfaces) give the named regions; elements of
 // other types are ignored except that mixing P1 and P2 tetrahedra is an error.

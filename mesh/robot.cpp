@@ -133,7 +133,7 @@ void name_gap_faces(Mesh& mesh, const std::vector<Cavity>& gaps, double tol) {
 // mesh names the mesh_size key's location.
 Mesh mesh_assembly(const Assembly& assembly, double mesh_size, int order, const ParamSet& params,
                    const std::string& type) {
-  const std::string source = params.context().empty() ? "geometry " + type : params.context();
+  const std::string source = geometry_source(params, type);
   ScopedGmshModel model("morphfem_robot");
   namespace occ = gmsh::model::occ;
   gmsh::vectorpair boxes;

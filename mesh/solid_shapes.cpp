@@ -19,10 +19,6 @@ namespace {
 
 constexpr double kHuge = std::numeric_limits<double>::max();
 
-std::string source_of(const ParamSet& params, const std::string& type) {
-  return params.context().empty() ? "geometry " + type : params.context();
-}
-
 }  // namespace
 
 Mesh build_hemisphere(const ParamSet& params) {
@@ -72,7 +68,7 @@ Mesh build_hemisphere(const ParamSet& params) {
   rules.push_back({"flat", [=](const NodeBox& b) { return b.min.z() > -tol; }});
   rules.push_back({"sphere", [](const NodeBox&) { return true; }});
   add_physical_groups(rules);
-  return mesh_from_current_gmsh_model(source_of(params, "hemisphere"));
+  return mesh_from_current_gmsh_model(geometry_source(params, "hemisphere"));
 }
 
 Mesh build_solid_cylinder(const ParamSet& params) {
@@ -103,7 +99,7 @@ Mesh build_solid_cylinder(const ParamSet& params) {
     rules.push_back({"inner", [=](const NodeBox& b) { return std::max(b.max.x(), b.max.z()) < r_mid; }});
   rules.push_back({"outer", [](const NodeBox&) { return true; }});
   add_physical_groups(rules);
-  return mesh_from_current_gmsh_model(source_of(params, "solid_cylinder"));
+  return mesh_from_current_gmsh_model(geometry_source(params, "solid_cylinder"));
 }
 
 }  // namespace morphfem
