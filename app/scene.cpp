@@ -486,7 +486,7 @@ Scene scene_from_yaml(const YAML::Node& root, const std::string& path) {
       }
     }
     if (const auto sc = c["self"]) {
-      r.allow(sc, "contact.self", {"pairs", "dhat", "kappa", "inflation", "start"});
+      r.allow(sc, "contact.self", {"pairs", "dhat", "kappa", "inflation", "max_trust_radius", "start"});
       if (sc["start"]) scene.self_contact_spec.start = r.number(sc["start"], "contact.self.start");
       scene.self_contact = true;
       const YAML::Node pairs = sc["pairs"];
@@ -498,10 +498,12 @@ Scene scene_from_yaml(const YAML::Node& root, const std::string& path) {
         scene.self_contact_spec.pairs.emplace_back(r.text(pair[0], "contact.self.pairs"),
                                                    r.text(pair[1], "contact.self.pairs"));
       }
-      // dhat [m], kappa [Pa], inflation [m]: 0 or absent selects the default.
+      // dhat [m], kappa [Pa], inflation [m], max_trust_radius [m]: 0 or absent selects
+      // the default.
       for (auto [key, value] :
            {std::pair{"dhat", &scene.self_contact_spec.dhat}, std::pair{"kappa", &scene.self_contact_spec.kappa},
-            std::pair{"inflation", &scene.self_contact_spec.inflation}}) {
+            std::pair{"inflation", &scene.self_contact_spec.inflation},
+            std::pair{"max_trust_radius", &scene.self_contact_spec.max_trust_radius}}) {
         if (!sc[key]) continue;
         *value = r.number(sc[key], std::string("contact.self.") + key);
         if (!(*value >= 0)) r.fail(sc[key], std::string("contact.self.") + key, "must not be negative");

@@ -365,6 +365,7 @@ SelfContactTerm::SelfContactTerm(const Mesh& mesh, const Partition& partition, i
   if (!(spec_.kappa > 0))
     throw InputError(where, "the barrier stiffness kappa [Pa] is not set (give kappa or the Young's modulus)");
   if (spec_.inflation <= 0) spec_.inflation = 20 * spec_.dhat;
+  spec_.max_trust_radius = std::max(spec_.max_trust_radius, 0.5 * spec_.inflation);
   if (!(spec_.max_step_fraction > 0 && spec_.max_step_fraction < 1))
     throw InputError(where, "max_step_fraction must lie in (0, 1)");
   rank_begin_ = partition.node_begin[rank];
@@ -420,11 +421,18 @@ Eigen::Matrix<double, 4, 3> SelfContactTerm::positions(const std::array<int, 4>&
 // triangle) pair is a candidate if the point is not a node of the triangle's face
 // and their distance is below reach (only points this rank owns); an edge pair if
 // the edges share no node and no parent face and their distance is below reach
-// (only pairs whose smallest node this rank owns).
+// (only pairs whose smallest node this rank owns). With far nodes (R > r/2) the
+// grids reach dhat + 2R and every rank measures every pair out to there, so the trust
+// radii are the same on every rank.
 void SelfContactTerm::build_candidates(const RowMatrixXd& x) {
   pairs_.clear();
   edge_pairs_.clear();
-  const double reach = spec_.dhat + spec_.inflation;
+  const double reach = spec_.dhat + spec_.inflation;              // candidates
+  const double search = spec_.dhat + 2 * spec_.max_trust_radius;  // trust radii (>= reach)
+  const bool far = search > reach;
+  // Nearest non-candidate distance per node, then rho = min((d - dhat)/2, R).
+  std::vector<double> nearest(mesh_.n_nodes(), std::numeric_limits<double>::infinity());
+  const auto note = [&](double d, const auto&... nodes) { ((nearest[nodes] = std::min(nearest[nodes], d)), ...); };
   const auto box = [&](const auto& nodes, Eigen::Vector3d& lo, Eigen::Vector3d& hi) {
     lo = x.row(nodes[0]);
     hi = lo;
@@ -437,21 +445,22 @@ void SelfContactTerm::build_candidates(const RowMatrixXd& x) {
   std::set<std::array<int, 4>> seen_edges;
   for (const auto& [side_a, side_b] : sides_) {
     for (const auto& [points, tris] : {std::pair{&side_a, &side_b}, std::pair{&side_b, &side_a}}) {
-      double size = reach;
+      double size = search;
       for (const auto& t : tris->triangles)
         for (int i = 0; i < 3; ++i) size = std::max(size, (x.row(t[i]) - x.row(t[(i + 1) % 3])).cwiseAbs().maxCoeff());
       std::map<Cell, std::vector<int>> grid;
       for (size_t t = 0; t < tris->triangles.size(); ++t) {
         Eigen::Vector3d lo, hi;
         box(tris->triangles[t], lo, hi);
-        const auto [x0, y0, z0] = grid_cell((lo.array() - reach).matrix(), size);
-        const auto [x1, y1, z1] = grid_cell((hi.array() + reach).matrix(), size);
+        const auto [x0, y0, z0] = grid_cell((lo.array() - search).matrix(), size);
+        const auto [x1, y1, z1] = grid_cell((hi.array() + search).matrix(), size);
         for (long i = x0; i <= x1; ++i)
           for (long j = y0; j <= y1; ++j)
             for (long k = z0; k <= z1; ++k) grid[{i, j, k}].push_back(static_cast<int>(t));
       }
       for (int p : points->points) {
-        if (p < rank_begin_ || p >= rank_end_) continue;
+        const bool owned = p >= rank_begin_ && p < rank_end_;
+        if (!owned && !far) continue;
         const auto it = grid.find(grid_cell(x.row(p).transpose(), size));
         if (it == grid.end()) continue;
         for (int t : it->second) {
@@ -463,23 +472,28 @@ void SelfContactTerm::build_candidates(const RowMatrixXd& x) {
           Eigen::Matrix<double, 4, 3> xs;
           xs.row(0) = x.row(p);
           for (int i = 0; i < 3; ++i) xs.row(i + 1) = x.row(tri[i]);
-          if (plain_distance(xs) >= reach) continue;
-          if (seen.insert({p, tri[0], tri[1], tri[2]}).second) pairs_.push_back(Pair{p, tri});
+          const double d = plain_distance(xs);
+          if (d >= search) continue;
+          if (d >= reach) {
+            note(d, p, tri[0], tri[1], tri[2]);
+          } else if (owned && seen.insert({p, tri[0], tri[1], tri[2]}).second) {
+            pairs_.push_back(Pair{p, tri});
+          }
         }
       }
     }
     if (!spec_.edge_edge) continue;
     // Edge pairs: edges of B in every cell their inflated box touches; each edge of
     // A looks in the cells of its own box (cells at least as large as any edge).
-    double size = reach;
+    double size = search;
     for (const auto& e : side_b.edges) size = std::max(size, (x.row(e[0]) - x.row(e[1])).cwiseAbs().maxCoeff());
     for (const auto& e : side_a.edges) size = std::max(size, (x.row(e[0]) - x.row(e[1])).cwiseAbs().maxCoeff());
     std::map<Cell, std::vector<int>> grid;
     for (size_t k = 0; k < side_b.edges.size(); ++k) {
       Eigen::Vector3d lo, hi;
       box(side_b.edges[k], lo, hi);
-      const auto [x0, y0, z0] = grid_cell((lo.array() - reach).matrix(), size);
-      const auto [x1, y1, z1] = grid_cell((hi.array() + reach).matrix(), size);
+      const auto [x0, y0, z0] = grid_cell((lo.array() - search).matrix(), size);
+      const auto [x1, y1, z1] = grid_cell((hi.array() + search).matrix(), size);
       for (long i = x0; i <= x1; ++i)
         for (long j = y0; j <= y1; ++j)
           for (long l = z0; l <= z1; ++l) grid[{i, j, l}].push_back(static_cast<int>(k));
@@ -502,7 +516,8 @@ void SelfContactTerm::build_candidates(const RowMatrixXd& x) {
         const auto& eb = side_b.edges[kb];
         if (ea[0] == eb[0] || ea[0] == eb[1] || ea[1] == eb[0] || ea[1] == eb[1]) continue;
         const int smallest = std::min(std::min(ea[0], ea[1]), std::min(eb[0], eb[1]));
-        if (smallest < rank_begin_ || smallest >= rank_end_) continue;
+        const bool owned = smallest >= rank_begin_ && smallest < rank_end_;
+        if (!owned && !far) continue;
         bool shared_face = false;
         for (int f : side_a.edge_faces[ka])
           for (int g : side_b.edge_faces[kb]) shared_face = shared_face || f == g;
@@ -512,8 +527,13 @@ void SelfContactTerm::build_candidates(const RowMatrixXd& x) {
             ea < eb ? std::array<int, 4>{ea[0], ea[1], eb[0], eb[1]} : std::array<int, 4>{eb[0], eb[1], ea[0], ea[1]};
         Eigen::Matrix<double, 4, 3> xs;
         for (int i = 0; i < 4; ++i) xs.row(i) = x.row(key[i]);
-        if (plain_edge_distance(xs) >= reach) continue;
-        if (!seen_edges.insert(key).second) continue;
+        const double d = plain_edge_distance(xs);
+        if (d >= search) continue;
+        if (d >= reach) {
+          note(d, key[0], key[1], key[2], key[3]);
+          continue;
+        }
+        if (!owned || !seen_edges.insert(key).second) continue;
         Eigen::Matrix<double, 4, 3> xref;
         for (int i = 0; i < 4; ++i) xref.row(i) = mesh_.X.row(key[i]);
         edge_pairs_.push_back(EdgePair{key, 0.5 * (side_a.edge_weight[ka] + side_b.edge_weight[kb]),
@@ -521,6 +541,8 @@ void SelfContactTerm::build_candidates(const RowMatrixXd& x) {
       }
     }
   }
+  trust_radius_.assign(mesh_.n_nodes(), 0.0);
+  for (int a : surface_nodes_) trust_radius_[a] = std::min(0.5 * (nearest[a] - spec_.dhat), spec_.max_trust_radius);
 }
 
 void SelfContactTerm::piece_nodes(int k, std::vector<int>& nodes) const {
@@ -538,12 +560,12 @@ void SelfContactTerm::piece_nodes(int k, std::vector<int>& nodes) const {
 
 double SelfContactTerm::piece(int k, const PieceState& s, Eigen::VectorXd* g, Eigen::MatrixXd* H) const {
   const int n_pairs = static_cast<int>(pairs_.size()), n_edge = static_cast<int>(edge_pairs_.size());
-  if (k >= n_pairs + n_edge) {  // trust region: |u - u_c| <= r/2
+  if (k >= n_pairs + n_edge) {  // trust region: |u - u_c| <= rho
     if (g) g->setZero(3);
     if (H) H->setZero(3, 3);
     const int node = trust_nodes_[k - n_pairs - n_edge];
     const double moved = (s.u.row(0).transpose() - anchor_[node]).norm();
-    return moved <= 0.5 * spec_.inflation ? 0.0 : std::numeric_limits<double>::infinity();
+    return moved <= trust_radius_[node] ? 0.0 : std::numeric_limits<double>::infinity();
   }
   const Eigen::Matrix<double, 4, 3> x = s.X + s.u;
   double e;
@@ -589,9 +611,9 @@ double SelfContactTerm::max_step(Assembler& assembler, Vec u, Vec du) {
     if (L <= 0) continue;
     alpha = std::min(alpha, spec_.max_step_fraction * plain_edge_distance(current(n)) / L);
   }
-  // Trust region: largest alpha with |a + alpha b| <= R, a = u - u_c, b = du.
-  const double R = 0.5 * spec_.inflation;
+  // Trust region: largest alpha with |a + alpha b| <= rho, a = u - u_c, b = du.
   for (int n : trust_nodes_) {
+    const double R = trust_radius_[n];
     const Eigen::Vector3d a = U(n) - anchor_[n], b = dU(n);
     const double bb = b.squaredNorm();
     if (bb <= 0) continue;
@@ -621,10 +643,14 @@ bool SelfContactTerm::refresh_pieces(const RowMatrixXd& U) {
   // with other groups, e.g. one chamber's walls) found at anchor positions y are
   // exactly those at Q y, and the group's trust region may be centred there. Q is the
   // least-squares fit (Umeyama, no scaling) of y to the current positions x over the
-  // group's nodes; the candidates are kept while max |x - Q y| <= r/4 in every group.
+  // group's nodes; the candidates are kept while |x - Q y| <= rho/2 at every node.
   // A body that rolls, falls or curls without deforming its contact surfaces then
   // rebuilds them (and the assembly pattern) only when they deform.
-  const double limit = 0.25 * spec_.inflation;
+  const auto within = [&](const std::vector<int>& group, const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& y) {
+    for (Eigen::Index i = 0; i < x.cols(); ++i)
+      if ((x.col(i) - y.col(i)).norm() > 0.5 * trust_radius_[group[i]]) return false;
+    return true;
+  };
   std::vector<Eigen::Matrix3Xd> fitted;
   bool moved = false;
   for (const std::vector<int>& group : rigid_groups_) {
@@ -635,14 +661,14 @@ bool SelfContactTerm::refresh_pieces(const RowMatrixXd& U) {
       y.col(i) = mesh_.X.row(a).transpose() + anchor_[a];
       x.col(i) = mesh_.X.row(a).transpose() + U.row(a).transpose();
     }
-    if ((x - y).colwise().norm().maxCoeff() <= limit) {
+    if (within(group, x, y)) {
       fitted.push_back(std::move(y));  // Q = I
       continue;
     }
     moved = true;
     const Eigen::Matrix4d Q = Eigen::umeyama(y, x, false);
     fitted.emplace_back((Q.topLeftCorner<3, 3>() * y).colwise() + Q.topRightCorner<3, 1>());
-    if ((x - fitted.back()).colwise().norm().maxCoeff() > limit) {
+    if (!within(group, x, fitted.back())) {
       refresh(U);
       return true;
     }

@@ -32,17 +32,28 @@
 // Candidates (broad phase): pairs with d < dhat + r at the configuration u_c of
 // construction (or of the last refresh), r = inflation [m], found with uniform
 // grids of triangle and edge bounding boxes. Pieces are fixed between refreshes,
-// so the term keeps every surface node within r/2 of u_c (energy +inf beyond, and
-// max_step stops there): then no pair outside the candidate set can come closer
-// than dhat (every distance is 1-Lipschitz in each node's position, so two nodes
-// moving r/2 each change it by at most r). During a run refresh_pieces() (called
-// by the solver before each step with the converged state) rebuilds the candidates
-// once some surface node has used half of that trust radius (motion > r/4); the
+// so the term keeps every surface node within its trust radius rho (r/2, or more
+// for far nodes, below) of u_c (energy +inf beyond, and max_step stops there): then
+// no pair outside the candidate set can come closer than dhat (every distance is
+// 1-Lipschitz in each node's position, so two nodes moving r/2 each change it by at
+// most r). During a run refresh_pieces() (called by the solver before each step with
+// the converged state) rebuilds the candidates once some surface node has used half
+// of its trust radius (motion > rho/2, r/4 near contact); the
 // solver then re-creates the assembly pattern. Motion is measured after removing the
 // best-fit rigid motion of each group of surface pairs that share nodes (e.g. one
 // chamber's walls): distances do not change under it, and the trust region moves with
 // it, so a body that rolls, falls or curls without deforming its contact surfaces
 // keeps its candidates.
+//
+// Far nodes move further. A node whose nearest feature outside the candidates was
+// d_i away at the search (non-candidate pairs have d >= dhat + r) may move
+//   rho_i = min((d_i - dhat) / 2, R)      (>= r/2; R = max_trust_radius >= r/2)
+// before a rebuild: a non-candidate pair, its nodes each moving at most rho <=
+// (d - dhat)/2, still keeps d >= dhat. The search measures pairs out to dhat + 2R for
+// this (only the ones within dhat + r become candidates). An inflated chamber, its
+// walls centimetres apart, then inflates and deflates with few rebuilds and no
+// trust-region step cuts, while a collapsing one keeps the tight r/2. With R = r/2
+// (the default) every node has r/2.
 //
 // max_step (conservative CCD): along u + alpha du the distance of a pair changes
 // by at most alpha L, L = max_i |du_i - du_p| over the triangle's vertices i (the
@@ -67,10 +78,11 @@ struct SelfContactSpec {
   std::string name = "self";
   // Surface regions that can meet; the same name twice: within one surface.
   std::vector<std::pair<std::string, std::string>> pairs;
-  double dhat = 0.0;           // barrier width [m]; <= 0: 1e-3 x bounding-box diagonal
-  double kappa = 0.0;          // barrier stiffness [Pa]; <= 0: young_modulus
-  double young_modulus = 0.0;  // [Pa], for the default kappa
-  double inflation = 0.0;      // candidate radius r beyond dhat [m]; <= 0: 20 dhat
+  double dhat = 0.0;              // barrier width [m]; <= 0: 1e-3 x bounding-box diagonal
+  double kappa = 0.0;             // barrier stiffness [Pa]; <= 0: young_modulus
+  double young_modulus = 0.0;     // [Pa], for the default kappa
+  double inflation = 0.0;         // candidate radius r beyond dhat [m]; <= 0: 20 dhat
+  double max_trust_radius = 0.0;  // largest trust radius R of a far node [m]; <= r/2: r/2
   double max_step_fraction = 0.9;
   bool project_hessian = true;  // per-pair PSD projection of the barrier Hessian
   bool edge_edge = true;        // include the edge-edge pairs
@@ -119,8 +131,8 @@ class SelfContactTerm : public EnergyTerm {
   void piece_nodes(int k, std::vector<int>& nodes) const override;
   double piece(int k, const PieceState& s, Eigen::VectorXd* g, Eigen::MatrixXd* H) const override;
   double max_step(Assembler& assembler, Vec u, Vec du) override;
-  // Rebuilds the candidates at u0 once a surface node moved more than r/4 since
-  // the last refresh, rigid motion removed (returns true: the solver re-creates the
+  // Rebuilds the candidates at u0 once a surface node moved more than half its trust
+  // radius (r/4 near contact) since the last refresh, rigid motion removed (returns true: the solver re-creates the
   // pattern); otherwise moves the trust region with the rigid motion. Collective.
   bool refresh_pieces(Assembler& assembler, Vec u0) override;
   // Whether contact has started, the displacement of the last candidate search (the
@@ -146,6 +158,8 @@ class SelfContactTerm : public EnergyTerm {
   int n_refreshes() const { return n_refreshes_; }
   // How often refresh_pieces moved the trust region rigidly instead of rebuilding.
   int n_reanchors() const { return n_reanchors_; }
+  // Trust radius rho of a mesh node since the last search [m] (0 off the surfaces).
+  double trust_radius(int node) const { return trust_radius_[node]; }
   // Smallest point-triangle / edge-edge distance over the candidate pairs [m] (collective).
   double min_distance(Assembler& assembler, Vec u) const;
   // Nodal forces and gaps of this rank's pairs at the whole displacement field u
@@ -192,6 +206,7 @@ class SelfContactTerm : public EnergyTerm {
   // moved rigidly. Checkpoints keep both, so a resumed run searches from the same
   // positions and finds the same candidates in the same order.
   std::vector<Eigen::Vector3d> searched_;
+  std::vector<double> trust_radius_;  // per mesh node: rho [m], the same on every rank
   int n_refreshes_ = 0;
   int n_reanchors_ = 0;
   bool active_ = true;

@@ -430,3 +430,113 @@ TEST(SelfContactTerm, EdgePairsStopCrossingEdgesThatNoVertexSees) {
     EXPECT_EQ(term_energy(term, mesh, 0.45 * u) > 0, edges) << "edge_edge " << edges;
   }
 }
+
+namespace {
+
+// Every point-triangle and edge-edge distance between surfaces "a" and "b" of the
+// crossing wedges at displacement u, candidates or not [m] (brute force).
+double smallest_distance_between_wedges(const Mesh& mesh, const RowMatrixXd& u) {
+  std::vector<std::array<int, 3>> tri[2];
+  for (int f = 0; f < mesh.faces.rows(); ++f)
+    tri[mesh.face_region[f] - 1].push_back({mesh.faces(f, 0), mesh.faces(f, 1), mesh.faces(f, 2)});
+  const auto at = [&](int n) { return Eigen::RowVector3d(mesh.X.row(n) + u.row(n)); };
+  double d = std::numeric_limits<double>::infinity();
+  for (int s = 0; s < 2; ++s)
+    for (const auto& p : tri[s])
+      for (const auto& t : tri[1 - s])
+        for (int i = 0; i < 3; ++i) {
+          Eigen::Matrix<double, 4, 3> x;
+          x << at(p[i]), at(t[0]), at(t[1]), at(t[2]);
+          d = std::min(d, point_triangle_distance(x));
+          for (int j = 0; j < 3; ++j) {
+            x << at(p[i]), at(p[(i + 1) % 3]), at(t[j]), at(t[(j + 1) % 3]);
+            d = std::min(d, edge_edge_distance(x));
+          }
+        }
+  return d;
+}
+
+}  // namespace
+
+// A node whose nearest feature outside the candidates is d away gets the trust
+// radius min((d - dhat)/2, R), never less than r/2: across the 4 mm plate (no
+// candidates at r = 1 mm) every node may move 1.5 mm, or R if smaller.
+TEST(SelfContactTerm, FarNodesGetTrustRadiiFromTheirNearestFeature) {
+  for (int order : {1, 2}) {
+    const Mesh mesh = thin_plate(order);
+    const Partition part = one_rank(mesh);
+    SelfContactSpec spec = across_the_plate();
+    spec.inflation = 1e-3;
+    const std::vector<int> surface = mesh.nodes_of_surface("zmin");
+    for (auto [R, expected] : {std::pair{0.0, 0.5e-3}, std::pair{1e-3, 1e-3}, std::pair{5e-3, 1.5e-3}}) {
+      spec.max_trust_radius = R;
+      const SelfContactTerm term(mesh, part, 0, spec);
+      EXPECT_EQ(term.n_pairs(), 0);
+      for (int a : surface) EXPECT_NEAR(term.trust_radius(a), expected, 1e-12) << "order " << order << " R " << R;
+    }
+  }
+}
+
+// The far radii keep their promise: moving every node anywhere within its own
+// radius leaves every pair, candidate or not, at least dhat apart, and the bound is
+// tight (the two wedge edges moved towards each other by their radii end at dhat).
+// Two ranks' terms (half the nodes each) give every node the same radius as one.
+TEST(SelfContactTerm, MotionWithinTheFarTrustRadiiKeepsEveryPairOutsideTheBarrier) {
+  const double gap = 3e-3;
+  const Mesh mesh = crossing_wedges(gap / 1e-2);
+  const Partition part = one_rank(mesh);
+  SelfContactSpec spec;
+  spec.pairs = {{"a", "b"}};
+  spec.dhat = 1e-4;
+  spec.kappa = 1e6;
+  spec.inflation = 1e-3;
+  spec.max_trust_radius = 5e-3;
+  const SelfContactTerm term(mesh, part, 0, spec);
+  ASSERT_EQ(term.n_pairs() + term.n_edge_pairs(), 0);  // nothing within dhat + r
+  // The edges' nodes (0, 1 of a; 4, 5 of b) are gap apart; the others farther.
+  for (int a : {0, 1, 4, 5}) EXPECT_NEAR(term.trust_radius(a), 0.5 * (gap - spec.dhat), 1e-12);
+  for (int a : {2, 3, 6, 7}) EXPECT_GT(term.trust_radius(a), 0.5 * (gap - spec.dhat) + 1e-4);
+  Partition two = part;
+  two.n_parts = 2;
+  two.node_begin = {0, 4, 8};
+  for (int rank : {0, 1}) {
+    const SelfContactTerm half(mesh, two, rank, spec);
+    for (int a = 0; a < 8; ++a) EXPECT_EQ(half.trust_radius(a), term.trust_radius(a)) << "rank " << rank;
+  }
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  for (int trial = 0; trial < 200; ++trial) {
+    RowMatrixXd u(mesh.n_nodes(), 3);
+    for (int a = 0; a < mesh.n_nodes(); ++a) {
+      Eigen::RowVector3d v(uniform(rng), uniform(rng), uniform(rng));
+      u.row(a) = term.trust_radius(a) * std::abs(uniform(rng)) * v.normalized();
+    }
+    EXPECT_EQ(term_energy(term, mesh, u), 0.0);  // inside the trust region
+    EXPECT_GE(smallest_distance_between_wedges(mesh, u), spec.dhat * (1 - 1e-12)) << "trial " << trial;
+  }
+  RowMatrixXd closing = RowMatrixXd::Zero(mesh.n_nodes(), 3);
+  for (int a : {0, 1}) closing(a, 2) = term.trust_radius(a);
+  for (int a : {4, 5}) closing(a, 2) = -term.trust_radius(a);
+  EXPECT_NEAR(smallest_distance_between_wedges(mesh, closing), spec.dhat, 1e-12);
+  EXPECT_EQ(term_energy(term, mesh, 1.001 * closing), std::numeric_limits<double>::infinity());
+}
+
+// Squeezing the 4 mm plate by 0.6 mm is past r/2 (0.5 mm) but well inside the far
+// radius (1.5 mm): the tight trust region must rebuild, the far one keeps its
+// (empty) candidates.
+TEST(SelfContactTerm, FarTrustRadiiRebuildLess) {
+  const Mesh mesh = thin_plate(1);
+  const Partition part = one_rank(mesh);
+  RowMatrixXd squeeze = RowMatrixXd::Zero(mesh.n_nodes(), 3);
+  for (int a = 0; a < mesh.n_nodes(); ++a) squeeze(a, 2) = -0.6e-3 * mesh.X(a, 2) / 0.004;
+  SelfContactSpec spec = across_the_plate();
+  spec.inflation = 1e-3;
+  SelfContactTerm tight(mesh, part, 0, spec);
+  spec.max_trust_radius = 5e-3;
+  SelfContactTerm far(mesh, part, 0, spec);
+  EXPECT_EQ(term_energy(tight, mesh, squeeze), std::numeric_limits<double>::infinity());
+  EXPECT_EQ(term_energy(far, mesh, squeeze), 0.0);
+  EXPECT_TRUE(tight.refresh_pieces(squeeze));
+  EXPECT_FALSE(far.refresh_pieces(squeeze));
+  EXPECT_EQ(far.n_refreshes(), 0);
+}
