@@ -23,6 +23,8 @@ import xml.etree.ElementTree as ET
 import h5py
 import numpy as np
 
+from result_regions import bladder_regions
+
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -76,22 +78,7 @@ def force_z(f, step):
 def chambers(args, f, X, steps, times):
     """Per step: each chamber's angle and lowest point, and the lowest point of each end."""
     region = f["/mesh/cell_region"]
-    names = {}
-    if args.bladder_regions:
-        try:
-            names = {f"bladder_{k + 1}": int(r) for k, r in enumerate(args.bladder_regions.split(","))}
-        except ValueError:
-            sys.exit(f"body_rotation.py: --bladder-regions {args.bladder_regions}: not comma-separated integers")
-    elif "names" in region.attrs:
-        for entry in region.attrs["names"]:
-            rid, name = (entry.decode() if isinstance(entry, bytes) else str(entry)).split(" ", 1)
-            names[name] = int(rid)
-    else:
-        sys.exit(f"body_rotation.py: {args.h5}: no region names (written before they were stored); "
-                 "give --bladder-regions")
-    ids = sorted((int(n.split("_")[1]), i) for n, i in names.items() if n.startswith("bladder_") and n[8:].isdigit())
-    if not ids:
-        sys.exit(f"body_rotation.py: {args.h5}: no bladder_K regions")
+    ids = bladder_regions("body_rotation.py", args.h5, region, args.bladder_regions)
     cells, cell_region = f["/mesh/cells"][:], region[:]
     y = X[:, 1]
     band = np.abs(y - 0.5 * (y.min() + y.max())) < min(0.02, 0.5 * (y.max() - y.min()) + 1e-12)

@@ -43,6 +43,8 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
+from result_regions import bladder_regions
+
 PROG = "chamber_walls.py"
 
 # Faces of a tetrahedron by its corners (each opposite one corner); orientation is fixed
@@ -86,7 +88,7 @@ def main():
     except (OSError, KeyError) as e:
         fail(args.h5, f"not a morphfem result ({e})")
     times = read_times(args.h5, f, steps)
-    ids = bladder_regions(args, region)
+    ids = bladder_regions(PROG, args.h5, region, args.bladder_regions)
     shown = [i for i, t in enumerate(times) if not args.window or args.window[0] <= t <= args.window[1]]
     shown = shown[:: args.every]
     if not shown:
@@ -150,26 +152,6 @@ def read_times(path, f, steps):
         if xdmf and os.path.exists(xdmf):
             fail(path, f"{xdmf} has {len(times)} times for {len(steps)} saved steps, and the steps no time attribute")
         fail(path, "no times (no XDMF beside it and the steps have no time attribute)")
-
-
-def bladder_regions(args, region):
-    """[(K, region id)] of the regions bladder_K, sorted by K."""
-    names = {}
-    if args.bladder_regions:
-        try:
-            names = {f"bladder_{k + 1}": int(r) for k, r in enumerate(args.bladder_regions.split(","))}
-        except ValueError:
-            sys.exit(f"{PROG}: --bladder-regions {args.bladder_regions}: not comma-separated integers")
-    elif "names" in region.attrs:
-        for entry in region.attrs["names"]:
-            rid, name = (entry.decode() if isinstance(entry, bytes) else str(entry)).split(" ", 1)
-            names[name] = int(rid)
-    else:
-        fail(args.h5, "no region names (written before they were stored); give --bladder-regions")
-    ids = sorted((int(n.split("_")[1]), i) for n, i in names.items() if n.startswith("bladder_") and n[8:].isdigit())
-    if not ids:
-        fail(args.h5, "no bladder_K regions")
-    return ids
 
 
 def p2_order(path, X, cells):
