@@ -289,6 +289,16 @@ Mesh crossing_wedges(double gap) {
   return mesh;
 }
 
+// Contact between the two wedges' surfaces: dhat 0.1 mm, r = 1 mm.
+SelfContactSpec between_the_wedges() {
+  SelfContactSpec spec;
+  spec.pairs = {{"a", "b"}};
+  spec.dhat = 1e-4;
+  spec.kappa = 1e6;
+  spec.inflation = 1e-3;
+  return spec;
+}
+
 // Total energy of a term's pieces at displacement u (n_nodes x 3).
 double term_energy(const EnergyTerm& term, const Mesh& mesh, const RowMatrixXd& u) {
   double total = 0;
@@ -402,11 +412,7 @@ TEST(SelfContactTerm, EdgePairsStopCrossingEdgesThatNoVertexSees) {
   const Mesh mesh = crossing_wedges(gap / 1e-2);
   const Partition part = one_rank(mesh);
   for (bool edges : {false, true}) {
-    SelfContactSpec spec;
-    spec.pairs = {{"a", "b"}};
-    spec.dhat = 1e-4;
-    spec.kappa = 1e6;
-    spec.inflation = 1e-3;
+    SelfContactSpec spec = between_the_wedges();
     spec.edge_edge = edges;
     SelfContactTerm term(mesh, part, 0, spec);
     EXPECT_EQ(term.n_edge_pairs() > 0, edges);
@@ -485,11 +491,7 @@ TEST(SelfContactTerm, MotionWithinTheFarTrustRadiiKeepsEveryPairOutsideTheBarrie
   const double gap = 3e-3;
   const Mesh mesh = crossing_wedges(gap / 1e-2);
   const Partition part = one_rank(mesh);
-  SelfContactSpec spec;
-  spec.pairs = {{"a", "b"}};
-  spec.dhat = 1e-4;
-  spec.kappa = 1e6;
-  spec.inflation = 1e-3;
+  SelfContactSpec spec = between_the_wedges();
   spec.max_trust_radius = 5e-3;
   const SelfContactTerm term(mesh, part, 0, spec);
   ASSERT_EQ(term.n_pairs() + term.n_edge_pairs(), 0);  // nothing within dhat + r
