@@ -304,6 +304,7 @@ int play(const Schedule& schedule, const ChannelMap& map, const PlayerOptions& o
 
   std::vector<double> follow(regs.size()), cmd(regs.size(), 0.0), meas(regs.size(), kNaN);
   std::vector<double> off_since(regs.size(), kNaN);
+  std::vector<int> off_samples(regs.size(), 0);  // consecutive exchanges out of the band
   auto rates = [&](std::size_t i, double& rise, double& fall) {
     int ch = regs[i].spec.channel;
     const ChannelLevels& l = levels[ch];
@@ -474,7 +475,8 @@ int play(const Schedule& schedule, const ChannelMap& map, const PlayerOptions& o
         double e = std::abs(meas[i] - cmd[i]);
         if (e > opt.tracking_fault_pa) {
           if (std::isnan(off_since[i])) off_since[i] = t;
-          if (t - off_since[i] >= opt.tracking_fault_s) {
+          ++off_samples[i];
+          if (t - off_since[i] >= opt.tracking_fault_s && off_samples[i] >= opt.tracking_fault_samples) {
             std::ostringstream m;
             m << "tracking fault on " << regs[i].label() << ": measured " << kpa(meas[i]) << " kPa, commanded "
               << kpa(cmd[i]) << " kPa for " << (t - off_since[i]) << " s (ruptured bladder, leak or stuck valve?)";
@@ -484,6 +486,7 @@ int play(const Schedule& schedule, const ChannelMap& map, const PlayerOptions& o
           }
         } else {
           off_since[i] = kNaN;
+          off_samples[i] = 0;
         }
         double tol = regs[i].spec.tolerance_pa > 0 ? regs[i].spec.tolerance_pa : tol_default;
         double target =

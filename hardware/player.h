@@ -40,6 +40,8 @@ struct PlayerOptions {
   double min_hold_s = 0;                     // settle mode: minimum column time
   double tracking_fault_pa = 15000;          // |measured - commanded| that counts as a fault ...
   double tracking_fault_s = 1.0;             // ... when it lasts this long (schedule seconds)
+  int tracking_fault_samples = 5;            // ... over at least this many consecutive exchanges: one
+                                             // late sample after a host stall is no evidence of a fault
   bool dry_run = false;                      // print the command stream, open no port
   bool display = false;                      // live commanded/measured line on `err`
   std::string log_path;                      // CSV log ("" = none)
