@@ -682,6 +682,11 @@ SimulationResult run_scene(const Scene& scene, MPI_Comm comm, const RunOptions& 
           .add("newton_its", result.stats.newton_its)
           .add("linear_its", result.stats.linear_its)
           .add("step_cuts", result.stats.step_cuts)
+          .add("step_cuts_by_cause", [&] {
+            Json causes;
+            for (const auto& [cause, n] : result.stats.cuts_by_cause) causes.add(cause, n);
+            return causes;
+          }())
           .add("wall_s", result.stats.wall_s)
           .add("resumed_at_s", result.resumed_at)
           .add("min_J", result.min_J)

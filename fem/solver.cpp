@@ -176,6 +176,7 @@ void QuasiStaticSolver::save_state(StateRecord& state) {
   state.integers["solver.linear_its"] = counters.linear_its;
   state.integers["solver.step_cuts"] = counters.step_cuts;
   state.integers["solver.error_rejections"] = counters.error_rejections;
+  for (const auto& [cause, n] : counters.cuts_by_cause) state.integers["solver.cuts." + cause] = n;
   state.integers["solver.terms"] = static_cast<long>(assembler_.terms().size());
   for (size_t k = 0; k < assembler_.terms().size(); ++k) {
     const std::string prefix = "term" + std::to_string(k);
@@ -208,6 +209,9 @@ RunStats QuasiStaticSolver::load_state(const StateRecord& state, const std::stri
   counters.linear_its = static_cast<int>(state.integer("solver.linear_its", where));
   counters.step_cuts = static_cast<int>(state.integer("solver.step_cuts", where));
   counters.error_rejections = static_cast<int>(state.integer("solver.error_rejections", where));
+  const std::string cuts = "solver.cuts.";  // absent in checkpoints written before the causes were kept
+  for (auto it = state.integers.lower_bound(cuts); it != state.integers.end() && it->first.rfind(cuts, 0) == 0; ++it)
+    counters.cuts_by_cause[it->first.substr(cuts.size())] = static_cast<int>(it->second);
   counters_ = counters;
   for (size_t k = 0; k < terms.size(); ++k) terms[k]->load_state(assembler_, "term" + std::to_string(k), state);
   rebuild_pattern();  // pieces that depend on the state (self-contact candidates) were rebuilt
@@ -414,6 +418,7 @@ bool QuasiStaticSolver::solve_step(double t_new, int& newton_its, int& linear_it
     apply_dirichlet(work_, t_new);
     if (!std::isfinite(assembler_.energy(work_))) {
       why = "the prescribed displacement increment inverts an element";
+      cause_ = "dirichlet_inverts";
       return false;
     }
   }
@@ -463,6 +468,7 @@ bool QuasiStaticSolver::solve_step(double t_new, int& newton_its, int& linear_it
     why = ierr                                 ? "PETSc error during the solve"
           : reason == SNES_CONVERGED_ITERATING ? "time-step error estimate above tolerance"
                                                : std::string("Newton: ") + SNESConvergedReasons[reason];
+    cause_ = ierr ? "petsc_error" : reason == SNES_CONVERGED_ITERATING ? "rejected_by_term" : SNESConvergedReasons[reason];
     for (const auto& term : assembler_.terms()) term->set_time(t_);
   }
   VecDestroy(&x);
@@ -515,6 +521,7 @@ RunStats QuasiStaticSolver::run(const std::function<void(const StepReport&)>& on
       }
     } else {
       ++stats.step_cuts;
+      ++stats.cuts_by_cause[cause_];
       ++cuts;
       dt = 0.5 * (t_new - t_);
       if (dt < opt_.dt_min) {

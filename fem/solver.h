@@ -13,6 +13,7 @@
 
 #include <array>
 #include <functional>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -56,6 +57,10 @@ struct StepReport {
 struct RunStats {
   int steps = 0, newton_its = 0, linear_its = 0, step_cuts = 0;
   int error_rejections = 0;  // steps retried because a time-error estimate was too large
+  // Step cuts by cause: a SNES reason (DIVERGED_MAX_IT, DIVERGED_LINE_SEARCH, ...),
+  // rejected_by_term (a term's advise_step refused a converged step), petsc_error or
+  // dirichlet_inverts (the prescribed increment alone inverts an element).
+  std::map<std::string, int> cuts_by_cause;
   double wall_s = 0;
   bool completed = false;
   std::string failure;  // diagnostic if !completed
@@ -120,6 +125,7 @@ class QuasiStaticSolver {
   int stalled_its_ = 0;                         // consecutive iterations without a 10 % residual decrease
   PetscBool linesearch_monitor_ = PETSC_FALSE;  // -morphfem_linesearch_monitor (read once)
   double length_scale_ = 1.0;                   // diagonal of the mesh's bounding box [m]
+  std::string cause_;  // short cause of the last failed attempt (RunStats::cuts_by_cause key)
   double advised_dt_ = 1e300;                   // smallest dt_next advised by the terms for the last attempt
 };
 

@@ -124,6 +124,10 @@ void expect_resume_matches(const std::string& name, const std::string& text, int
   EXPECT_EQ(a.stats.steps, b.stats.steps);
   EXPECT_EQ(a.stats.newton_its, b.stats.newton_its);
   EXPECT_EQ(a.stats.step_cuts, b.stats.step_cuts);
+  EXPECT_EQ(a.stats.cuts_by_cause, b.stats.cuts_by_cause);  // kept in the checkpoint
+  int by_cause = 0;
+  for (const auto& [cause, n] : b.stats.cuts_by_cause) by_cause += n;
+  EXPECT_EQ(by_cause, b.stats.step_cuts);
   const double scale = a.u.cwiseAbs().maxCoeff();
   ASSERT_GT(scale, 0.0);
   EXPECT_LE(max_abs_diff(a.u, b.u), 1e-12 * scale) << "final displacement";
@@ -150,6 +154,21 @@ void expect_resume_matches(const std::string& name, const std::string& text, int
 TEST(Resume, SlidingBlockWithFrictionContinuesExactly) { expect_resume_matches("slide", kSlide, 7, 0); }
 
 TEST(Resume, ValveFedBalloonWithBdf2AndDampingContinuesExactly) { expect_resume_matches("balloon", kBalloon, 4, 3); }
+
+// The sliding block with at most six Newton iterations per step has its steps
+// cut: the counts by cause continue across the checkpoints as the other counters do.
+TEST(Resume, StepCutsKeepTheirCausesAcrossCheckpoints) {
+  SceneFile once("cuts_once", kSlide);
+  once.doc["solver"]["max_newton_its"] = 6;
+  const auto a = run_scene(once.scene(), PETSC_COMM_WORLD, once.options(false));
+  ASSERT_TRUE(a.stats.completed) << a.stats.failure;
+  ASSERT_GT(a.stats.step_cuts, 0);
+  EXPECT_EQ(a.stats.cuts_by_cause.count("DIVERGED_MAX_IT"), 1u);
+  YAML::Node doc = YAML::LoadFile(kSlide);
+  doc["name"] = "slide_cuts";
+  doc["solver"]["max_newton_its"] = 6;
+  expect_resume_matches("slide_cuts", YAML::Dump(doc), 30, 40);
+}
 
 // A finished run extended to a later end time takes the same steps as a run
 // straight to that time that also lands a step on the old end time.
