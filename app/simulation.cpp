@@ -665,6 +665,13 @@ SimulationResult run_scene(const Scene& scene, MPI_Comm comm, const RunOptions& 
   if (write) save_checkpoint(tmp_dir);  // the final state: a later run may extend it (--resume)
   result.stats.wall_s = wall_before + std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
+  // Candidate pairs of the last self-contact search, over every rank.
+  long self_candidates[2] = {0, 0};
+  if (self_contact) {
+    self_candidates[0] = self_contact->n_pairs();
+    self_candidates[1] = self_contact->n_edge_pairs();
+    MPI_Allreduce(MPI_IN_PLACE, self_candidates, 2, MPI_LONG, MPI_SUM, comm);
+  }
   if (write) {
     if (rank == 0) {
       writer->close();
@@ -682,11 +689,12 @@ SimulationResult run_scene(const Scene& scene, MPI_Comm comm, const RunOptions& 
           .add("newton_its", result.stats.newton_its)
           .add("linear_its", result.stats.linear_its)
           .add("step_cuts", result.stats.step_cuts)
-          .add("step_cuts_by_cause", [&] {
-            Json causes;
-            for (const auto& [cause, n] : result.stats.cuts_by_cause) causes.add(cause, n);
-            return causes;
-          }())
+          .add("step_cuts_by_cause",
+               [&] {
+                 Json causes;
+                 for (const auto& [cause, n] : result.stats.cuts_by_cause) causes.add(cause, n);
+                 return causes;
+               }())
           .add("wall_s", result.stats.wall_s)
           .add("resumed_at_s", result.resumed_at)
           .add("min_J", result.min_J)
@@ -694,9 +702,11 @@ SimulationResult run_scene(const Scene& scene, MPI_Comm comm, const RunOptions& 
           .add("max_displacement_m", result.u.rowwise().norm().maxCoeff())
           .add("pattern_rebuilds", solver.pattern_rebuilds());
       if (self_contact)  // candidate searches, and rigid moves of the trust region instead of one
-        summary.add(
-            "self_contact",
-            Json().add("refreshes", self_contact->n_refreshes()).add("rigid_reanchors", self_contact->n_reanchors()));
+        summary.add("self_contact", Json()
+                                        .add("refreshes", self_contact->n_refreshes())
+                                        .add("rigid_reanchors", self_contact->n_reanchors())
+                                        .add("point_triangle_candidates", self_candidates[0])
+                                        .add("edge_edge_candidates", self_candidates[1]));
       std::vector<Json> cavs;
       for (size_t i = 0; i < result.cavity_names.size(); ++i) {
         Json c;

@@ -129,6 +129,8 @@ class SelfContactTerm : public EnergyTerm {
     return active_ ? static_cast<int>(pairs_.size() + edge_pairs_.size() + trust_nodes_.size()) : 0;
   }
   void piece_nodes(int k, std::vector<int>& nodes) const override;
+  // Candidates beyond dhat (most of them) and trust-region pieces are zero.
+  bool sparse_pieces() const override { return true; }
   double piece(int k, const PieceState& s, Eigen::VectorXd* g, Eigen::MatrixXd* H) const override;
   double max_step(Assembler& assembler, Vec u, Vec du) override;
   // Rebuilds the candidates at u0 once a surface node moved more than half its trust

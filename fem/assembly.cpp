@@ -2,9 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <numeric>
 #include <stdexcept>
+#include <unordered_map>
 
 #include "fem/petsc_check.h"
 
@@ -106,7 +108,13 @@ void Assembler::setup() {
   coo_i_.clear();
   coo_j_.clear();
   coo_offset_.assign(terms_.size(), {});
+  block_first_.assign(terms_.size(), {});
+  block_offset_.assign(terms_.size(), {});
   for (size_t t = 0; t < terms_.size(); ++t) {
+    if (terms_[t]->sparse_pieces()) {
+      setup_shared_blocks(t);
+      continue;
+    }
     coo_offset_[t].resize(terms_[t]->n_pieces());
     for (int k = 0; k < terms_[t]->n_pieces(); ++k) {
       terms_[t]->piece_nodes(k, nodes);
@@ -127,6 +135,32 @@ void Assembler::setup() {
     coo_j_.push_back(d);
   }
   coo_v_.assign(coo_i_.size(), 0.0);
+}
+
+void Assembler::setup_shared_blocks(std::size_t t) {
+  const EnergyTerm& term = *terms_[t];
+  std::unordered_map<std::uint64_t, std::size_t> block;  // row node * n_nodes + column node -> first value
+  std::vector<int> nodes;
+  auto& first = block_first_[t];
+  auto& offset = block_offset_[t];
+  first.resize(term.n_pieces() + 1);
+  for (int k = 0; k < term.n_pieces(); ++k) {
+    first[k] = offset.size();
+    term.piece_nodes(k, nodes);
+    for (int b : nodes)
+      for (int a : nodes) {
+        const std::uint64_t key = static_cast<std::uint64_t>(a) * mesh_.n_nodes() + static_cast<std::uint64_t>(b);
+        auto [it, added] = block.try_emplace(key, coo_i_.size());
+        if (added)
+          for (int j = 0; j < 3; ++j)
+            for (int i = 0; i < 3; ++i) {
+              coo_i_.push_back(constrained_[3 * a + i] ? -1 : 3 * a + i);
+              coo_j_.push_back(constrained_[3 * b + j] ? -1 : 3 * b + j);
+            }
+        offset.push_back(it->second);
+      }
+  }
+  first[term.n_pieces()] = offset.size();
 }
 
 const std::vector<double>& Assembler::gather(Vec u) {
@@ -186,9 +220,10 @@ double Assembler::gradient(Vec u, Vec gvec) {
   PETSC_CHECK(VecSetOption(gvec, VEC_IGNORE_NEGATIVE_INDICES, PETSC_TRUE));
   double e =
       sweep(u, true, false,
-            [&](size_t, int, const std::vector<PetscInt>& idx, double energy, const Eigen::VectorXd& g,
+            [&](size_t t, int, const std::vector<PetscInt>& idx, double energy, const Eigen::VectorXd& g,
                 const Eigen::MatrixXd&) {
-              if (!std::isfinite(energy)) return;  // outside the domain: no meaningful gradient
+              if (!std::isfinite(energy)) return;                     // outside the domain: no meaningful gradient
+              if (!block_first_[t].empty() && g.isZero(0.0)) return;  // a sparse term's inactive piece
               PETSC_CHECK(VecSetValues(gvec, static_cast<PetscInt>(idx.size()), idx.data(), g.data(), ADD_VALUES));
             });
   PETSC_CHECK(VecAssemblyBegin(gvec));
@@ -200,9 +235,14 @@ void Assembler::hessian(Vec u, Mat Hmat) {
   // Values go into the coordinate list built by setup() and reach PETSc in one
   // MatSetValuesCOO: measured on the voxel robot (3,060 dofs, P1), per-piece
   // MatSetValues took ~40 % of the run, most of it searching for columns.
+  std::fill(coo_v_.begin(), coo_v_.begin() + static_cast<long>(coo_diagonal_), 0.0);  // the shared blocks sum
   sweep(u, false, true,
         [&](size_t t, int k, const std::vector<PetscInt>& idx, double energy, const Eigen::VectorXd&,
             const Eigen::MatrixXd& H) {
+          if (!block_first_[t].empty()) {
+            add_to_shared_blocks(t, k, idx.size() / 3, energy, H);
+            return;
+          }
           if (static_cast<std::size_t>(k) >= coo_offset_[t].size())
             throw std::logic_error("Assembler::hessian: a term gained pieces without setup()");
           const std::size_t n = idx.size(), begin = coo_offset_[t][k];
@@ -217,6 +257,20 @@ void Assembler::hessian(Vec u, Mat Hmat) {
   for (PetscInt d = owned_dof_begin(); d < owned_dof_end(); ++d)
     coo_v_[coo_diagonal_ + static_cast<std::size_t>(d - owned_dof_begin())] = constrained_[d] ? 1.0 : 0.0;
   PETSC_CHECK(MatSetValuesCOO(Hmat, coo_v_.data(), INSERT_VALUES));
+}
+
+void Assembler::add_to_shared_blocks(std::size_t t, int k, std::size_t n, double energy, const Eigen::MatrixXd& H) {
+  const auto& first = block_first_[t];
+  if (static_cast<std::size_t>(k) + 1 >= first.size() || first[k + 1] - first[k] != n * n)
+    throw std::logic_error("Assembler::hessian: a piece changed its nodes without setup()");
+  if (!std::isfinite(energy) || H.size() == 0 || H.isZero(0.0)) return;  // the common case: no contribution
+  const std::size_t* offset = block_offset_[t].data() + first[k];
+  for (std::size_t b = 0; b < n; ++b)
+    for (std::size_t a = 0; a < n; ++a) {
+      double* v = coo_v_.data() + offset[b * n + a];
+      for (int j = 0; j < 3; ++j)
+        for (int i = 0; i < 3; ++i) v[3 * j + i] += H(3 * a + i, 3 * b + j);
+    }
 }
 
 RowMatrixXd Assembler::gather_all(Vec u) const {

@@ -73,6 +73,8 @@ class Assembler {
   template <class Visit>
   double sweep(Vec u, bool want_g, bool want_H, Visit&& visit);
   void load_piece(int k, const EnergyTerm& term, PieceState& s, std::vector<int>& nodes) const;
+  void setup_shared_blocks(std::size_t t);  // coordinate list of a term with sparse_pieces()
+  void add_to_shared_blocks(std::size_t t, int k, std::size_t n, double energy, const Eigen::MatrixXd& H);
 
   const Mesh& mesh_;
   const Partition& partition_;
@@ -91,6 +93,11 @@ class Assembler {
   std::vector<PetscInt> coo_i_, coo_j_;
   std::vector<PetscScalar> coo_v_;
   std::vector<std::vector<std::size_t>> coo_offset_;  // [term][piece] -> first value
+  // Terms with sparse_pieces(): [term][piece] -> first entry in block_offset_[term],
+  // which lists, for the piece's n x n node pairs (column-major), the first value
+  // of the pair's shared 3 x 3 block (column-major).
+  std::vector<std::vector<std::size_t>> block_first_;
+  std::vector<std::vector<std::size_t>> block_offset_;
   std::size_t coo_diagonal_ = 0;                      // first constrained-diagonal value
 };
 

@@ -37,6 +37,13 @@ class EnergyTerm {
   // rejects the step.
   virtual double piece(int k, const PieceState& s, Eigen::VectorXd* g, Eigen::MatrixXd* H) const = 0;
 
+  // True if at any state most pieces are zero (contact candidates beyond the
+  // barrier). The assembler then stores the term's Hessian in one 3 x 3 block per
+  // coupled node pair, shared by every piece that couples them, and adds only the
+  // nonzero pieces, instead of one n x n block per piece: the pattern and the work
+  // scale with the coupled node pairs, not with the candidates. Same matrix.
+  virtual bool sparse_pieces() const { return false; }
+
   // Time-dependent parameters (pressure, traction, friction at time t) [s].
   virtual void set_time(double /*t*/) {}
   // Called once before every sweep over the pieces with the full displacement on
