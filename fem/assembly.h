@@ -98,7 +98,7 @@ class Assembler {
   // of the pair's shared 3 x 3 block (column-major).
   std::vector<std::vector<std::size_t>> block_first_;
   std::vector<std::vector<std::size_t>> block_offset_;
-  std::size_t coo_diagonal_ = 0;                      // first constrained-diagonal value
+  std::size_t coo_diagonal_ = 0;  // first constrained-diagonal value
 };
 
 }  // namespace morphfem
