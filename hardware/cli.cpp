@@ -24,6 +24,7 @@ const char* kUsage =
     "       morphfem hw play SCHEDULE --map MAP [--port [DEVICE=]PATH]... [--mode fixed|settle|step]\n"
     "                        [--time-scale S] [--tick-ms N] [--reply-timeout-ms N] [--reconnect-s S]\n"
     "                        [--settle-timeout-s S] [--min-hold-s S] [--tracking-fault-pa P] [--tracking-fault-s S]\n"
+    "                        [--tracking-fault-samples N]\n"
     "                        [--log FILE.csv] [--dry-run] [--no-display]\n"
     "       morphfem hw emulate --map MAP [--link DEVICE=PATH]... [--time-scale S] [--seed N]\n"
     "                        [--noise-pa P] [--rupture-pa P] [--fault KIND@T[:ARG]]... [--duration-s S]\n";
@@ -110,7 +111,11 @@ int hardware_main(const std::vector<std::string>& args) {
         po.tracking_fault_pa = number_arg(a, value());
       else if (a == "--tracking-fault-s")
         po.tracking_fault_s = number_arg(a, value());
-      else if (a == "--min-hold-s")
+      else if (a == "--tracking-fault-samples") {
+        const double n = number_arg(a, value());
+        if (!(n >= 1 && n == static_cast<int>(n))) throw InputError(a, "must be a positive integer");
+        po.tracking_fault_samples = static_cast<int>(n);
+      } else if (a == "--min-hold-s")
         po.min_hold_s = number_arg(a, value());
       else if (a == "--log")
         po.log_path = value();

@@ -225,6 +225,18 @@ TEST(Player, RefusesPressuresBeyondLimitsBeforeSendingAnything) {
   std::filesystem::remove_all(dir);
 }
 
+TEST(Player, CliRefusesABadTrackingFaultSampleCount) {
+  for (const std::string bad : {"0", "2.5", "many"}) {
+    std::ostringstream cli_err;
+    auto* old_err = std::cerr.rdbuf(cli_err.rdbuf());
+    int code = hardware_main({"play", kExamples + "rolling.yaml", "--map", kExamples + "channel_map.yaml",
+                              "--tracking-fault-samples", bad, "--dry-run"});
+    std::cerr.rdbuf(old_err);
+    EXPECT_EQ(code, kExitInput) << bad;
+    EXPECT_NE(cli_err.str().find("--tracking-fault-samples"), std::string::npos) << cli_err.str();
+  }
+}
+
 TEST(Player, DryRunPrintsTheCommandStream) {
   ChannelMap m = read_channel_map(kExamples + "channel_map.yaml");
   PlayerOptions opt;
