@@ -468,7 +468,9 @@ bool QuasiStaticSolver::solve_step(double t_new, int& newton_its, int& linear_it
     why = ierr                                 ? "PETSc error during the solve"
           : reason == SNES_CONVERGED_ITERATING ? "time-step error estimate above tolerance"
                                                : std::string("Newton: ") + SNESConvergedReasons[reason];
-    cause_ = ierr ? "petsc_error" : reason == SNES_CONVERGED_ITERATING ? "rejected_by_term" : SNESConvergedReasons[reason];
+    cause_ = ierr                                 ? "petsc_error"
+             : reason == SNES_CONVERGED_ITERATING ? "rejected_by_term"
+                                                  : SNESConvergedReasons[reason];
     for (const auto& term : assembler_.terms()) term->set_time(t_);
   }
   VecDestroy(&x);

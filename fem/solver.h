@@ -125,7 +125,7 @@ class QuasiStaticSolver {
   int stalled_its_ = 0;                         // consecutive iterations without a 10 % residual decrease
   PetscBool linesearch_monitor_ = PETSC_FALSE;  // -morphfem_linesearch_monitor (read once)
   double length_scale_ = 1.0;                   // diagonal of the mesh's bounding box [m]
-  std::string cause_;  // short cause of the last failed attempt (RunStats::cuts_by_cause key)
+  std::string cause_;                           // short cause of the last failed attempt (RunStats::cuts_by_cause key)
   double advised_dt_ = 1e300;                   // smallest dt_next advised by the terms for the last attempt
 };
 
