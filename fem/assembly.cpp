@@ -110,6 +110,7 @@ void Assembler::setup() {
   coo_offset_.assign(terms_.size(), {});
   block_first_.assign(terms_.size(), {});
   block_offset_.assign(terms_.size(), {});
+  block_values_.clear();
   for (size_t t = 0; t < terms_.size(); ++t) {
     if (terms_[t]->sparse_pieces()) {
       setup_shared_blocks(t);
@@ -143,6 +144,7 @@ void Assembler::setup_shared_blocks(std::size_t t) {
   std::vector<int> nodes;
   auto& first = block_first_[t];
   auto& offset = block_offset_[t];
+  const std::size_t values_begin = coo_i_.size();
   first.resize(term.n_pieces() + 1);
   for (int k = 0; k < term.n_pieces(); ++k) {
     first[k] = offset.size();
@@ -161,6 +163,7 @@ void Assembler::setup_shared_blocks(std::size_t t) {
       }
   }
   first[term.n_pieces()] = offset.size();
+  block_values_.emplace_back(values_begin, coo_i_.size());
 }
 
 const std::vector<double>& Assembler::gather(Vec u) {
@@ -235,7 +238,8 @@ void Assembler::hessian(Vec u, Mat Hmat) {
   // Values go into the coordinate list built by setup() and reach PETSc in one
   // MatSetValuesCOO: measured on the voxel robot (3,060 dofs, P1), per-piece
   // MatSetValues took ~40 % of the run, most of it searching for columns.
-  std::fill(coo_v_.begin(), coo_v_.begin() + static_cast<long>(coo_diagonal_), 0.0);  // the shared blocks sum
+  for (const auto& [begin, end] : block_values_)  // the shared blocks sum their pieces
+    std::fill(coo_v_.begin() + static_cast<long>(begin), coo_v_.begin() + static_cast<long>(end), 0.0);
   sweep(u, false, true,
         [&](size_t t, int k, const std::vector<PetscInt>& idx, double energy, const Eigen::VectorXd&,
             const Eigen::MatrixXd& H) {

@@ -14,6 +14,7 @@
 #include <petscvec.h>
 
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include "fem/energy.h"
@@ -98,7 +99,8 @@ class Assembler {
   // of the pair's shared 3 x 3 block (column-major).
   std::vector<std::vector<std::size_t>> block_first_;
   std::vector<std::vector<std::size_t>> block_offset_;
-  std::size_t coo_diagonal_ = 0;  // first constrained-diagonal value
+  std::vector<std::pair<std::size_t, std::size_t>> block_values_;  // each such term's [first, end) values
+  std::size_t coo_diagonal_ = 0;                                   // first constrained-diagonal value
 };
 
 }  // namespace morphfem
