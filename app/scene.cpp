@@ -198,7 +198,7 @@ Scene scene_from_yaml(const YAML::Node& root, const std::string& path) {
   if (const auto s = root["solver"]) {
     r.allow(s, "solver",
             {"end_time", "initial_step", "min_step", "max_step", "linear_solver", "quadrature_degree", "max_newton_its",
-             "rtol", "formulation"});
+             "rtol", "formulation", "hessian_projection", "easy_newton_its"});
     auto positive = [&](const char* key, double& out) { r.optional_positive(s, "solver", key, out); };
     positive("end_time", scene.solver.t_end);
     positive("initial_step", scene.solver.dt_initial);
@@ -209,6 +209,11 @@ Scene scene_from_yaml(const YAML::Node& root, const std::string& path) {
       scene.solver.linear_solver = r.text(s["linear_solver"], "solver.linear_solver");
       if (scene.solver.linear_solver != "mumps" && scene.solver.linear_solver != "gamg")
         r.fail(s["linear_solver"], "solver.linear_solver", "must be 'mumps' or 'gamg'");
+    }
+    if (s["hessian_projection"]) {
+      scene.solver.hessian_projection = r.text(s["hessian_projection"], "solver.hessian_projection");
+      if (scene.solver.hessian_projection != "adaptive" && scene.solver.hessian_projection != "always")
+        r.fail(s["hessian_projection"], "solver.hessian_projection", "must be 'adaptive' or 'always'");
     }
     if (s["formulation"]) {
       scene.formulation = r.text(s["formulation"], "solver.formulation");
@@ -228,6 +233,11 @@ Scene scene_from_yaml(const YAML::Node& root, const std::string& path) {
       double q = r.number(s["max_newton_its"], "solver.max_newton_its");
       if (q < 1 || q != int(q)) r.fail(s["max_newton_its"], "solver.max_newton_its", "must be a positive integer");
       scene.solver.max_newton_its = int(q);
+    }
+    if (s["easy_newton_its"]) {
+      double q = r.number(s["easy_newton_its"], "solver.easy_newton_its");
+      if (q < 1 || q != int(q)) r.fail(s["easy_newton_its"], "solver.easy_newton_its", "must be a positive integer");
+      scene.solver.easy_newton_its = int(q);
     }
   } else {
     scene.solver.t_end = 1.0;
@@ -486,8 +496,11 @@ Scene scene_from_yaml(const YAML::Node& root, const std::string& path) {
       }
     }
     if (const auto sc = c["self"]) {
-      r.allow(sc, "contact.self", {"pairs", "dhat", "kappa", "inflation", "max_trust_radius", "start"});
+      r.allow(sc, "contact.self",
+              {"pairs", "dhat", "kappa", "inflation", "max_trust_radius", "start", "project_hessian"});
       if (sc["start"]) scene.self_contact_spec.start = r.number(sc["start"], "contact.self.start");
+      if (sc["project_hessian"])
+        scene.self_contact_spec.project_hessian = r.flag(sc["project_hessian"], "contact.self.project_hessian");
       scene.self_contact = true;
       const YAML::Node pairs = sc["pairs"];
       if (!pairs || !pairs.IsSequence() || pairs.size() == 0)

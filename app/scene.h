@@ -41,7 +41,11 @@
 //       - {surface: foot, stiffness: 2000, velocity: [1.667e-3, 0, 0], start: 0}   # N/m, m/s, s
 //   solver: {end_time: 1, initial_step: 0.1, min_step: 1e-6, max_step: 1,
 //            linear_solver: mumps|gamg, quadrature_degree: 0, max_newton_its: 30,
-//            formulation: displacement}
+//            easy_newton_its: 6,   # a step that converged in at most this many iterations grows 1.5x
+//            formulation: displacement, hessian_projection: always}
+//            # hessian_projection: always = terms project their Hessians to PSD (self-contact
+//            # pairs, friction's static-to-kinetic drop); adaptive = the exact Hessian after a
+//            # full Newton step, falling back if its direction does not descend (fem/solver.h)
 //   dynamics:                                   # absent: quasi-static (no inertia)
 //     {scheme: newmark|bdf2|implicit_euler, lumped: false, adaptive: false,
 //      error_tolerance: 1e-4, shear_viscosity: 0, bulk_viscosity: 0,   # Pa s (Kelvin-Voigt)
@@ -62,6 +66,7 @@
 //           # (contact/self_contact.h: dhat 1e-3 x box diagonal, kappa 3 mu of the material
 //           # under the pairs' surfaces, inflation 20 dhat);
 //           # start [s]: the barrier acts only from then on (default: from the start)
+//           # project_hessian: true (default) projects each pair's barrier Hessian to PSD
 //   actuation:                                  # a schedule file shared with `morphfem hw play`
 //     {schedule: schedules/rolling.yaml, start: 1.0,      # gait time 0 at t = start [s]
 //      bladders: {b1: bladder_1_wall, ...},               # channel -> cavity wall surface

@@ -700,7 +700,9 @@ SimulationResult run_scene(const Scene& scene, MPI_Comm comm, const RunOptions& 
           .add("min_J", result.min_J)
           .add("mass_kg", result.mass_kg)
           .add("max_displacement_m", result.u.rowwise().norm().maxCoeff())
-          .add("pattern_rebuilds", solver.pattern_rebuilds());
+          .add("pattern_rebuilds", solver.pattern_rebuilds())
+          .add("exact_hessian_its", result.stats.exact_hessian_its)  // adaptive Hessian projection
+          .add("projection_fallbacks", result.stats.projection_fallbacks);
       if (self_contact)  // candidate searches, and rigid moves of the trust region instead of one
         summary.add("self_contact", Json()
                                         .add("refreshes", self_contact->n_refreshes())

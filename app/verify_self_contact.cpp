@@ -192,7 +192,7 @@ RowMatrixXd term_forces(const EnergyTerm& term, const Mesh& mesh, const RowMatri
 
 }  // namespace
 
-TubeVacuumResult run_tube_vacuum(double h, int order, MPI_Comm comm, bool progress) {
+TubeVacuumResult run_tube_vacuum(double h, int order, MPI_Comm comm, bool progress, BarrierHessian hessian) {
   int rank;
   MPI_Comm_rank(comm, &rank);
   // The mesh is built once on rank 0 and handed to the scene as a .msh file
@@ -238,9 +238,10 @@ TubeVacuumResult run_tube_vacuum(double h, int order, MPI_Comm comm, bool progre
   s.self_contact_spec.kappa = 3 * kMu;
   s.self_contact_spec.inflation = kInflation;
   // The exact barrier Hessian: the walls' elastic stiffness keeps the total Hessian
-  // positive near equilibrium, and per-pair PSD projection would make Newton
-  // converge only linearly (measured: many steps stalled at 30 iterations).
-  s.self_contact_spec.project_hessian = false;
+  // positive near equilibrium, and per-pair PSD projection in every iteration makes
+  // Newton converge only linearly (measured: many steps stalled at 30 iterations).
+  s.self_contact_spec.project_hessian = hessian != BarrierHessian::exact;
+  s.solver.hessian_projection = hessian == BarrierHessian::adaptive ? "adaptive" : "always";
   s.solver.t_end = 1.0;
   s.solver.dt_initial = 0.02;
   s.solver.dt_max = 0.1;

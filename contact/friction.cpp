@@ -151,7 +151,7 @@ double FrictionTerm::piece(int k, const PieceState& s, Eigen::VectorXd* g, Eigen
     *H = lambda * phi_over_y * tangent_projector_;
     if (y > 0) {
       double dphi = f.dforce(y);
-      if (spec_.project_hessian) dphi = std::max(dphi, 0.0);
+      if (spec_.project_hessian && !exact_hessian_) dphi = std::max(dphi, 0.0);
       const Eigen::Vector3d rhat = r / y;
       *H += lambda * (dphi - phi_over_y) * rhat * rhat.transpose();
     }

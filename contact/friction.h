@@ -90,6 +90,8 @@ class FrictionTerm : public EnergyTerm {
   void set_time(double t) override;
   void begin_step(Assembler& assembler, Vec u0, double t0, double t1) override;
   bool update_after_solve(Assembler& assembler, Vec u1) override;
+  // With project_hessian, the exact (unclamped) Hessian while set (adaptive projection).
+  void set_exact_hessian(bool exact) override { exact_hessian_ = exact; }
 
   const FrictionSpec& spec() const { return spec_; }
   // For tests: sets the lagged state of piece k directly (normal force [N], start
@@ -121,6 +123,7 @@ class FrictionTerm : public EnergyTerm {
   const Mesh& mesh_;
   std::shared_ptr<const GroundContactTerm> ground_;
   FrictionSpec spec_;
+  bool exact_hessian_ = false;
   Eigen::Matrix3d tangent_projector_;
   std::vector<int> nodes_;                          // pieces: owned friction nodes
   std::vector<std::vector<double>> region_weight_;  // per piece, per region: area [m^2]

@@ -575,7 +575,7 @@ double SelfContactTerm::piece(int k, const PieceState& s, Eigen::VectorXd* g, Ei
     const EdgePair& ep = edge_pairs_[k - n_pairs];
     e = edge_edge_barrier(x, ep.weight, spec_.kappa, spec_.dhat, ep.eps, g, H);
   }
-  if (H && spec_.project_hessian && std::isfinite(e) && e > 0) {
+  if (H && spec_.project_hessian && !exact_hessian_ && std::isfinite(e) && e > 0) {
     Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(*H);
     const Eigen::VectorXd lambda = es.eigenvalues().cwiseMax(0.0);
     *H = es.eigenvectors() * lambda.asDiagonal() * es.eigenvectors().transpose();

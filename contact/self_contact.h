@@ -131,6 +131,8 @@ class SelfContactTerm : public EnergyTerm {
   void piece_nodes(int k, std::vector<int>& nodes) const override;
   // Candidates beyond dhat (most of them) and trust-region pieces are zero.
   bool sparse_pieces() const override { return true; }
+  // With project_hessian, the exact pair Hessians while set (the solver's adaptive projection).
+  void set_exact_hessian(bool exact) override { exact_hessian_ = exact; }
   double piece(int k, const PieceState& s, Eigen::VectorXd* g, Eigen::MatrixXd* H) const override;
   double max_step(Assembler& assembler, Vec u, Vec du) override;
   // Rebuilds the candidates at u0 once a surface node moved more than half its trust
@@ -186,6 +188,7 @@ class SelfContactTerm : public EnergyTerm {
   const Mesh& mesh_;
   int rank_begin_ = 0, rank_end_ = 0;
   SelfContactSpec spec_;
+  bool exact_hessian_ = false;
   std::vector<double> weight_;  // nodal area weight [m^2] per mesh node
   // Per surface pair: points of side A against triangles of side B (and B vs A),
   // edges of A against edges of B.

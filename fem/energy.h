@@ -44,6 +44,13 @@ class EnergyTerm {
   // scale with the coupled node pairs, not with the candidates. Same matrix.
   virtual bool sparse_pieces() const { return false; }
 
+  // Terms that project their Hessian to PSD (per-pair barrier Hessians, friction's
+  // static-to-kinetic drop) give the exact Hessian while `exact` is set. The solver's
+  // adaptive projection sets it once Newton takes full steps: near a minimum the
+  // total Hessian is positive definite and the exact one converges quadratically,
+  // where the projected one converges linearly (SolverOptions::hessian_projection).
+  virtual void set_exact_hessian(bool /*exact*/) {}
+
   // Time-dependent parameters (pressure, traction, friction at time t) [s].
   virtual void set_time(double /*t*/) {}
   // Called once before every sweep over the pieces with the full displacement on

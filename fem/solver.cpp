@@ -52,6 +52,9 @@ PetscErrorCode convergence_trampoline(SNES snes, PetscInt it, PetscReal, PetscRe
 
 QuasiStaticSolver::QuasiStaticSolver(Assembler& assembler, std::vector<DirichletCondition> bcs, SolverOptions options)
     : assembler_(assembler), bcs_(std::move(bcs)), opt_(std::move(options)) {
+  if (opt_.hessian_projection != "adaptive" && opt_.hessian_projection != "always")
+    throw InputError("solver.hessian_projection",
+                     "unknown Hessian projection '" + opt_.hessian_projection + "' (allowed: adaptive, always)");
   PETSC_CHECK(PetscOptionsGetBool(nullptr, nullptr, "-morphfem_linesearch_monitor", &linesearch_monitor_, nullptr));
   std::vector<int> dofs;
   for (const auto& bc : bcs_)
@@ -171,6 +174,8 @@ void QuasiStaticSolver::save_state(StateRecord& state) {
   state.set_number("solver.dt_next", dt_next_);
   state.set_number("solver.fnorm_scale", fnorm_scale_);
   state.integers["solver.pattern_rebuilds"] = pattern_rebuilds_;
+  state.integers["solver.exact_hessian_its"] = exact_hessian_its_;
+  state.integers["solver.projection_fallbacks"] = projection_fallbacks_;
   state.integers["solver.steps"] = counters.steps;
   state.integers["solver.newton_its"] = counters.newton_its;
   state.integers["solver.linear_its"] = counters.linear_its;
@@ -203,6 +208,12 @@ RunStats QuasiStaticSolver::load_state(const StateRecord& state, const std::stri
   dt_next_ = state.number("solver.dt_next", where);
   fnorm_scale_ = state.number("solver.fnorm_scale", where);
   pattern_rebuilds_ = static_cast<int>(state.integer("solver.pattern_rebuilds", where));
+  // Absent in checkpoints written before the adaptive projection.
+  const auto optional = [&](const std::string& key) {
+    return state.integers.count(key) ? static_cast<int>(state.integers.at(key)) : 0;
+  };
+  exact_hessian_its_ = optional("solver.exact_hessian_its");
+  projection_fallbacks_ = optional("solver.projection_fallbacks");
   RunStats counters;
   counters.steps = static_cast<int>(state.integer("solver.steps", where));
   counters.newton_its = static_cast<int>(state.integer("solver.newton_its", where));
@@ -225,7 +236,10 @@ void QuasiStaticSolver::clear_low_rank() {
 
 PetscErrorCode QuasiStaticSolver::jacobian(Vec u, Mat J, Mat P) {
   try {
+    for (const auto& term : assembler_.terms()) term->set_exact_hessian(exact_hessian_);
+    if (exact_hessian_) ++exact_hessian_its_;
     assembler_.hessian(u, P);
+    for (const auto& term : assembler_.terms()) term->set_exact_hessian(false);
     if (J_) {
       clear_low_rank();
       for (const auto& term : assembler_.terms()) term->low_rank(assembler_, u, low_rank_);
@@ -277,6 +291,21 @@ PetscErrorCode QuasiStaticSolver::line_search(SNESLineSearch ls) {
   PetscReal slope;  // d/dlambda E(X - lambda Y) at 0 = -F.Y
   PetscCall(VecDot(F, Y, &slope));
   slope = -slope;
+  if (!(slope < 0) && exact_hessian_) {
+    // The exact Hessian is indefinite along this direction: re-solve with the
+    // projected one (adaptive projection), which is positive semi-definite.
+    exact_hessian_ = false;
+    ++projection_fallbacks_;
+    Mat A, B;
+    KSP ksp;
+    PetscCall(SNESGetJacobian(snes, &A, &B, nullptr, nullptr));
+    PetscCall(SNESComputeJacobian(snes, X, A, B));
+    PetscCall(SNESGetKSP(snes, &ksp));
+    PetscCall(KSPSetOperators(ksp, A, B));
+    PetscCall(KSPSolve(ksp, F, Y));
+    PetscCall(VecDot(F, Y, &slope));
+    slope = -slope;
+  }
   if (!(slope < 0)) {
     PetscReal ynorm, fnorm;
     PetscCall(VecNorm(Y, NORM_2, &ynorm));
@@ -324,8 +353,9 @@ PetscErrorCode QuasiStaticSolver::line_search(SNESLineSearch ls) {
   // -morphfem_linesearch_monitor: the admissible step, the term that bounds it, and
   // the accepted step (diagnosing stagnating Newton iterations).
   if (linesearch_monitor_) {
-    PetscCall(PetscPrintf(assembler_.comm(), "      line search: max step %.3e (%s), %s %.3e, slope %.3e\n", lambda_max,
-                          limiter.c_str(), accepted ? "accepted" : "rejected down to", lambda, slope));
+    PetscCall(PetscPrintf(assembler_.comm(), "      line search: max step %.3e (%s), %s %.3e, slope %.3e, %s Hessian\n",
+                          lambda_max, limiter.c_str(), accepted ? "accepted" : "rejected down to", lambda, slope,
+                          exact_hessian_ ? "exact" : "projected"));
     if (lambda < lambda_max) {  // backtracked: which terms' energies rose over the largest step
       const std::vector<double> before = assembler_.term_energies(X);
       PetscCall(VecWAXPY(W, -lambda_max, Y, X));
@@ -340,6 +370,9 @@ PetscErrorCode QuasiStaticSolver::line_search(SNESLineSearch ls) {
     PetscCall(SNESLineSearchSetReason(ls, SNES_LINESEARCH_FAILED_REDUCT));
     return 0;
   }
+  // Adaptive projection: a full Newton step (not backtracked, not bounded by a
+  // term's max_step) makes the next iteration exact.
+  exact_hessian_ = opt_.hessian_projection == "adaptive" && lambda == 1.0;
   PetscCall(SNESLineSearchSetLambda(ls, lambda));
   PetscCall(VecCopy(W, X));
   PetscCall(SNESComputeFunction(snes, X, F));
@@ -429,6 +462,7 @@ bool QuasiStaticSolver::solve_step(double t_new, int& newton_its, int& linear_it
   SNESConvergedReason reason = SNES_DIVERGED_FUNCTION_DOMAIN;
   newton_its = linear_its = 0;
   for (int outer = 0; outer <= opt_.max_outer_updates; ++outer) {
+    exact_hessian_ = false;  // every solve starts projected
     ierr = SNESSolve(snes_, nullptr, x);
     if (ierr) break;
     SNESGetConvergedReason(snes_, &reason);
@@ -506,6 +540,8 @@ RunStats QuasiStaticSolver::run(const std::function<void(const StepReport&)>& on
       ++stats.steps;
       stats.newton_its += its;
       stats.linear_its += lits;
+      stats.exact_hessian_its = exact_hessian_its_;
+      stats.projection_fallbacks = projection_fallbacks_;
       StepReport report{stats.steps, t_, dt_prev_, its, lits, cuts, assembler_.energy(u_)};
       if (its <= opt_.easy_newton_its && cuts == 0) dt = std::min(dt * opt_.grow, opt_.dt_max);
       dt = std::min(dt, advised_dt_);
@@ -535,6 +571,8 @@ RunStats QuasiStaticSolver::run(const std::function<void(const StepReport&)>& on
       }
     }
   }
+  stats.exact_hessian_its = exact_hessian_its_;
+  stats.projection_fallbacks = projection_fallbacks_;
   stats.completed = stats.failure.empty();
   stats.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return stats;

@@ -105,6 +105,21 @@ TEST(Scene, BadNumberNamesTheLine) {
   EXPECT_NE(e.find("scene.yaml:4:"), std::string::npos) << e;
 }
 
+TEST(Scene, BadSolverChoicesNameTheKeyAndTheAllowedValues) {
+  std::string e = error_of(replace(kGood, "solver: {end_time: 1", "solver: {hessian_projection: never, end_time: 1"));
+  EXPECT_NE(e.find("scene.yaml:8:"), std::string::npos) << e;
+  EXPECT_NE(e.find("solver.hessian_projection"), std::string::npos) << e;
+  EXPECT_NE(e.find("'adaptive' or 'always'"), std::string::npos) << e;
+  e = error_of(replace(kGood, "solver: {end_time: 1", "solver: {easy_newton_its: 2.5, end_time: 1"));
+  EXPECT_NE(e.find("solver.easy_newton_its"), std::string::npos) << e;
+  EXPECT_NE(e.find("positive integer"), std::string::npos) << e;
+  TempScene s(
+      replace(kGood, "solver: {end_time: 1", "solver: {hessian_projection: always, easy_newton_its: 9, end_time: 1"));
+  const Scene scene = read_scene(s.file.string());
+  EXPECT_EQ(scene.solver.hessian_projection, "always");
+  EXPECT_EQ(scene.solver.easy_newton_its, 9);
+}
+
 TEST(Scene, NegativeModulusIsRejected) {
   std::string e = error_of(replace(kGood, "mu: 1.0e5", "mu: -1.0e5"));
   EXPECT_NE(e.find("mu"), std::string::npos) << e;

@@ -199,8 +199,11 @@ TEST_P(FrictionFD, GradientAndHessianMatchFiniteDifferences) {
     FrictionSpec fs;
     fs.regions = {{"zmin", TimeFunction::constant(0.6), TimeFunction::constant(mu_k)}};
     fs.eps_v = 1e-3;
-    fs.project_hessian = false;
+    // The exact Hessian two ways: no projection at all (level ground), or a projecting
+    // term asked for the exact one by the solver's adaptive projection (inclined).
+    fs.project_hessian = inclined == 1;
     FrictionTerm term(mesh, part, 0, ground, fs);
+    if (inclined) term.set_exact_hessian(true);
     const double h_step = 0.1;
     term.set_step_length(h_step);
     const double eps = fs.eps_v * h_step;
@@ -264,7 +267,23 @@ TEST(Friction, ProjectedHessianIsPositiveSemidefinite) {
     term.piece(0, s, nullptr, &H);
     Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(H);
     EXPECT_GE(es.eigenvalues().minCoeff(), -1e-12 * H.norm()) << "y/eps " << y;
+    // The exact Hessian (adaptive projection) has the drop's negative curvature, and
+    // only inside the drop (eps, 2 eps); the term projects again once released.
+    term.set_exact_hessian(true);
+    term.piece(0, s, nullptr, &H);
+    term.set_exact_hessian(false);
+    const double min_exact = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(H).eigenvalues().minCoeff();
+    if (y > 1.0 && y < 2.0)
+      EXPECT_LT(min_exact, -1e-6 * H.norm()) << "y/eps " << y;
+    else
+      EXPECT_GE(min_exact, -1e-12 * H.norm()) << "y/eps " << y;
   }
+  PieceState s;
+  s.X = mesh.X.row(nodes[0]);
+  s.u = Eigen::RowVector3d(1.5 * eps * 0.6, 1.5 * eps * 0.8, 0);
+  Eigen::MatrixXd H;
+  term.piece(0, s, nullptr, &H);
+  EXPECT_GE(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(H).eigenvalues().minCoeff(), -1e-12 * H.norm());
 }
 
 // Two regions meeting at an edge; coefficients switch over time. A node inside a
