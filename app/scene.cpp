@@ -205,16 +205,24 @@ Scene scene_from_yaml(const YAML::Node& root, const std::string& path) {
     positive("min_step", scene.solver.dt_min);
     positive("max_step", scene.solver.dt_max);
     positive("rtol", scene.solver.rtol);
-    if (s["linear_solver"]) {
-      scene.solver.linear_solver = r.text(s["linear_solver"], "solver.linear_solver");
-      if (scene.solver.linear_solver != "mumps" && scene.solver.linear_solver != "gamg")
-        r.fail(s["linear_solver"], "solver.linear_solver", "must be 'mumps' or 'gamg'");
-    }
-    if (s["hessian_projection"]) {
-      scene.solver.hessian_projection = r.text(s["hessian_projection"], "solver.hessian_projection");
-      if (scene.solver.hessian_projection != "adaptive" && scene.solver.hessian_projection != "always")
-        r.fail(s["hessian_projection"], "solver.hessian_projection", "must be 'adaptive' or 'always'");
-    }
+    // A choice of two names, or a positive integer.
+    const auto either = [&](const char* key, std::string& out, const std::string& a, const std::string& b) {
+      if (!s[key]) return;
+      const std::string where = std::string("solver.") + key;
+      out = r.text(s[key], where);
+      if (out != a && out != b) r.fail(s[key], where, "must be '" + a + "' or '" + b + "'");
+    };
+    const auto positive_integer = [&](const char* key, int& out) {
+      if (!s[key]) return;
+      const std::string where = std::string("solver.") + key;
+      const double q = r.number(s[key], where);
+      if (q < 1 || q != int(q)) r.fail(s[key], where, "must be a positive integer");
+      out = int(q);
+    };
+    either("linear_solver", scene.solver.linear_solver, "mumps", "gamg");
+    either("hessian_projection", scene.solver.hessian_projection, "adaptive", "always");
+    positive_integer("max_newton_its", scene.solver.max_newton_its);
+    positive_integer("easy_newton_its", scene.solver.easy_newton_its);
     if (s["formulation"]) {
       scene.formulation = r.text(s["formulation"], "solver.formulation");
       if (!elastic_formulations().count(scene.formulation)) {
@@ -228,16 +236,6 @@ Scene scene_from_yaml(const YAML::Node& root, const std::string& path) {
       double q = r.number(s["quadrature_degree"], "solver.quadrature_degree");
       if (q < 0 || q > 6 || q != int(q)) r.fail(s["quadrature_degree"], "solver.quadrature_degree", "must be 0..6");
       scene.quadrature_degree = int(q);
-    }
-    if (s["max_newton_its"]) {
-      double q = r.number(s["max_newton_its"], "solver.max_newton_its");
-      if (q < 1 || q != int(q)) r.fail(s["max_newton_its"], "solver.max_newton_its", "must be a positive integer");
-      scene.solver.max_newton_its = int(q);
-    }
-    if (s["easy_newton_its"]) {
-      double q = r.number(s["easy_newton_its"], "solver.easy_newton_its");
-      if (q < 1 || q != int(q)) r.fail(s["easy_newton_its"], "solver.easy_newton_its", "must be a positive integer");
-      scene.solver.easy_newton_its = int(q);
     }
   } else {
     scene.solver.t_end = 1.0;
