@@ -288,12 +288,11 @@ PetscErrorCode QuasiStaticSolver::line_search(SNESLineSearch ls) {
   SNES snes;
   PetscCall(SNESLineSearchGetSNES(ls, &snes));
   const double e0 = assembler_.energy(X);
-  PetscReal slope;  // d/dlambda E(X - lambda Y) at 0 = -F.Y
-  PetscCall(VecDot(F, Y, &slope));
-  slope = -slope;
-  if (!(slope < 0) && exact_hessian_) {
-    // The exact Hessian is indefinite along this direction: re-solve with the
-    // projected one (adaptive projection), which is positive semi-definite.
+  PetscReal fnorm_old;
+  PetscCall(VecNorm(F, NORM_2, &fnorm_old));
+  // Adaptive projection's fallback: re-solve for Y with the projected Hessian, which
+  // is positive semi-definite (the exact one may be indefinite along Y).
+  const auto reproject = [&]() -> PetscErrorCode {
     exact_hessian_ = false;
     ++projection_fallbacks_;
     Mat A, B;
@@ -303,52 +302,63 @@ PetscErrorCode QuasiStaticSolver::line_search(SNESLineSearch ls) {
     PetscCall(SNESGetKSP(snes, &ksp));
     PetscCall(KSPSetOperators(ksp, A, B));
     PetscCall(KSPSolve(ksp, F, Y));
+    return 0;
+  };
+  PetscReal slope;  // d/dlambda E(X - lambda Y) at 0 = -F.Y
+  double lambda = 1.0, lambda_max = 1.0;
+  std::string limiter = "none";
+  bool accepted = false;
+  for (;;) {
     PetscCall(VecDot(F, Y, &slope));
     slope = -slope;
-  }
-  if (!(slope < 0)) {
-    PetscReal ynorm, fnorm;
-    PetscCall(VecNorm(Y, NORM_2, &ynorm));
-    PetscCall(VecNorm(F, NORM_2, &fnorm));
-    PetscCall(VecCopy(F, Y));
-    if (fnorm > 0) PetscCall(VecScale(Y, ynorm / fnorm));
-    slope = -ynorm * fnorm;
-  }
-  PetscReal fnorm_old;
-  PetscCall(VecNorm(F, NORM_2, &fnorm_old));
-  // Largest admissible step along du = -Y (contact barriers, ...).
-  double lambda = 1.0;
-  std::string limiter = "none";
-  PetscCall(VecCopy(Y, W));
-  PetscCall(VecScale(W, -1.0));
-  for (const auto& term : assembler_.terms()) {
-    const double l = term->max_step(assembler_, X, W);
-    if (l < lambda) {
-      lambda = l;
-      limiter = term->name();
+    if (!(slope < 0) && exact_hessian_) {  // not a descent direction
+      PetscCall(reproject());
+      continue;
     }
-  }
-  if (!(lambda > 0)) {
-    PetscCall(SNESLineSearchSetReason(ls, SNES_LINESEARCH_FAILED_DOMAIN));
-    return 0;
-  }
-  const double lambda_max = lambda;
-  bool accepted = false;
-  for (int attempt = 0; attempt < 40 && !accepted; ++attempt, lambda *= 0.5) {
-    PetscCall(VecWAXPY(W, -lambda, Y, X));
-    const double e = assembler_.energy(W);
-    if (!std::isfinite(e)) continue;
-    const double noise = 1e-12 * std::max(1.0, std::abs(e0));
-    if (e <= e0 + 1e-4 * lambda * slope) {
-      accepted = true;
-    } else if (e <= e0 + noise) {
-      // Energy change below round-off: accept if the residual decreases.
-      PetscCall(SNESComputeFunction(snes, W, G));
-      PetscReal gnorm;
-      PetscCall(VecNorm(G, NORM_2, &gnorm));
-      accepted = gnorm < fnorm_old;
+    if (!(slope < 0)) {
+      PetscReal ynorm;
+      PetscCall(VecNorm(Y, NORM_2, &ynorm));
+      PetscCall(VecCopy(F, Y));
+      if (fnorm_old > 0) PetscCall(VecScale(Y, ynorm / fnorm_old));
+      slope = -ynorm * fnorm_old;
     }
-    if (accepted) break;
+    // Largest admissible step along du = -Y (contact barriers, ...).
+    lambda = 1.0;
+    limiter = "none";
+    PetscCall(VecCopy(Y, W));
+    PetscCall(VecScale(W, -1.0));
+    for (const auto& term : assembler_.terms()) {
+      const double l = term->max_step(assembler_, X, W);
+      if (l < lambda) {
+        lambda = l;
+        limiter = term->name();
+      }
+    }
+    if (!(lambda > 0)) {
+      PetscCall(SNESLineSearchSetReason(ls, SNES_LINESEARCH_FAILED_DOMAIN));
+      return 0;
+    }
+    lambda_max = lambda;
+    for (int attempt = 0; attempt < 40 && !accepted; ++attempt, lambda *= 0.5) {
+      PetscCall(VecWAXPY(W, -lambda, Y, X));
+      const double e = assembler_.energy(W);
+      if (!std::isfinite(e)) continue;
+      const double noise = 1e-12 * std::max(1.0, std::abs(e0));
+      if (e <= e0 + 1e-4 * lambda * slope) {
+        accepted = true;
+      } else if (e <= e0 + noise) {
+        // Energy change below round-off: accept if the residual decreases.
+        PetscCall(SNESComputeFunction(snes, W, G));
+        PetscReal gnorm;
+        PetscCall(VecNorm(G, NORM_2, &gnorm));
+        accepted = gnorm < fnorm_old;
+      }
+      if (accepted) break;
+    }
+    // A descent direction of the exact Hessian along which the energy does not
+    // decrease enough: once more with the projected one.
+    if (accepted || !exact_hessian_) break;
+    PetscCall(reproject());
   }
   // -morphfem_linesearch_monitor: the admissible step, the term that bounds it, and
   // the accepted step (diagnosing stagnating Newton iterations).

@@ -45,11 +45,12 @@ struct SolverOptions {
   // "always": terms that project their Hessian to PSD (EnergyTerm::set_exact_hessian)
   // always do. "adaptive": the first iteration of a solve and every one after a
   // damped (backtracked or CCD-bounded) step are projected; after a full Newton step
-  // the next is exact, and if its direction does not descend the line search
-  // re-solves with the projected Hessian. Projection makes the Newton tail linear
-  // (the residual halving per iteration on the rolling sleeve with self-contact);
-  // the exact Hessian restores quadratic convergence where it is positive definite.
-  std::string hessian_projection = "always";  // adaptive: opt-in until its test is affordable
+  // the next is exact, and if its direction does not descend, or the line search
+  // finds no decrease along it, the line search re-solves with the projected
+  // Hessian. Projection makes the Newton tail linear (the residual halving per
+  // iteration on the rolling sleeve with self-contact); the exact Hessian restores
+  // quadratic convergence where it is positive definite.
+  std::string hessian_projection = "always";  // adaptive: opt-in (README, "stalled on the Hessian's projection")
   std::vector<double> output_times;           // steps land exactly on these times
 };
 
