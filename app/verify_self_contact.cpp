@@ -240,7 +240,7 @@ TubeVacuumResult run_tube_vacuum(double h, int order, MPI_Comm comm, bool progre
   // The exact barrier Hessian: the walls' elastic stiffness keeps the total Hessian
   // positive near equilibrium, and per-pair PSD projection in every iteration makes
   // Newton converge only linearly (measured: many steps stalled at 30 iterations).
-  s.self_contact_spec.project_hessian = hessian != BarrierHessian::exact;
+  s.self_contact_spec.project_hessian = hessian == BarrierHessian::adaptive;
   s.solver.hessian_projection = hessian == BarrierHessian::adaptive ? "adaptive" : "always";
   s.solver.t_end = 1.0;
   s.solver.dt_initial = 0.02;

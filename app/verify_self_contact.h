@@ -76,10 +76,10 @@ struct TubeVacuumResult {
   double inflation = 0, dhat = 0;  // of the self-contact term [m]
 };
 
-// The barrier's Hessian in Newton: exact per pair (the verification case), projected
-// per pair to PSD in every iteration, or projected until Newton takes full steps
+// The barrier's Hessian in Newton: exact per pair (the verification case), or
+// projected per pair to PSD until Newton takes full steps
 // (SolverOptions::hessian_projection "adaptive").
-enum class BarrierHessian { exact, projected, adaptive };
+enum class BarrierHessian { exact, adaptive };
 
 // One run at mesh size h [m] and element order.
 TubeVacuumResult run_tube_vacuum(double h, int order, MPI_Comm comm, bool progress,

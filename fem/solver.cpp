@@ -550,8 +550,6 @@ RunStats QuasiStaticSolver::run(const std::function<void(const StepReport&)>& on
       ++stats.steps;
       stats.newton_its += its;
       stats.linear_its += lits;
-      stats.exact_hessian_its = exact_hessian_its_;
-      stats.projection_fallbacks = projection_fallbacks_;
       StepReport report{stats.steps, t_, dt_prev_, its, lits, cuts, assembler_.energy(u_)};
       if (its <= opt_.easy_newton_its && cuts == 0) dt = std::min(dt * opt_.grow, opt_.dt_max);
       dt = std::min(dt, advised_dt_);
