@@ -42,10 +42,11 @@
 //   solver: {end_time: 1, initial_step: 0.1, min_step: 1e-6, max_step: 1,
 //            linear_solver: mumps|gamg, quadrature_degree: 0, max_newton_its: 30,
 //            easy_newton_its: 6,   # a step that converged in at most this many iterations grows 1.5x
-//            formulation: displacement, hessian_projection: always}
-//            # hessian_projection: always = terms project their Hessians to PSD (self-contact
-//            # pairs, friction's static-to-kinetic drop); adaptive = the exact Hessian after a
-//            # full Newton step, falling back if its direction does not descend (fem/solver.h)
+//            formulation: displacement, hessian_projection: adaptive}
+//            # hessian_projection: adaptive (default) = the exact Hessian after a full Newton
+//            # step, falling back to the projected one if it does not descend or the line
+//            # search fails along it; always = terms project their Hessians to PSD in every
+//            # iteration (self-contact pairs, friction's static-to-kinetic drop) (fem/solver.h)
 //   dynamics:                                   # absent: quasi-static (no inertia)
 //     {scheme: newmark|bdf2|implicit_euler, lumped: false, adaptive: false,
 //      error_tolerance: 1e-4, shear_viscosity: 0, bulk_viscosity: 0,   # Pa s (Kelvin-Voigt)

@@ -50,8 +50,8 @@ struct SolverOptions {
   // Hessian. Projection makes the Newton tail linear (the residual halving per
   // iteration on the rolling sleeve with self-contact); the exact Hessian restores
   // quadratic convergence where it is positive definite.
-  std::string hessian_projection = "always";  // adaptive: opt-in (README, "stalled on the Hessian's projection")
-  std::vector<double> output_times;           // steps land exactly on these times
+  std::string hessian_projection = "adaptive";  // README, "stalled on the Hessian's projection"
+  std::vector<double> output_times;             // steps land exactly on these times
 };
 
 struct StepReport {
