@@ -2,7 +2,8 @@
 // its volume region, joined by OCC boolean fragments; cavities are the empty boxes the
 // pieces enclose. Surfaces are named after meshing from a representative triangle of
 // each boundary surface entity: inside a cavity box -> that cavity's wall; outward
-// normal -z -> bottom (and a foot if it is the skin's bottom face in a foot band);
+// normal -z -> bottom (and a foot if it is the skin's bottom face in a foot band, or in
+// the voxel preset an end or side face of the bottom layer there);
 // otherwise outer. The same outside surfaces are also split by material for
 // friction: the feet, bladder_surface (a bladder's faces) and skin_surface (the rest).
 #include "mesh/robot.h"
@@ -54,8 +55,12 @@ struct Assembly {
   double length = 0.0;                    // body length along y
   double foot_length = 0.0;               // feet: y in [0, foot_length] and [length - foot_length, length]
   double foot_z = 0.0;                    // z of the skin's bottom face (the feet plane)
-  double scale = 0.0;                     // largest body dimension (for tolerances)
-  std::vector<double> sheet_z;            // z of internal planes named fabric_sheet (membranes)
+  // z of the top of the layer the feet belong to: > foot_z makes a foot of every
+  // outside skin face of that layer in a band (its bottom, end and side faces, as the
+  // lattice's foot voxels are whole voxels); = foot_z: the bottom face only.
+  double foot_top_z = 0.0;
+  double scale = 0.0;           // largest body dimension (for tolerances)
+  std::vector<double> sheet_z;  // z of internal planes named fabric_sheet (membranes)
   // Air gaps (chambers bonded along a strip): the outside faces whose centroids lie in
   // a box are also named after it, for self-contact across the gap.
   std::vector<Cavity> gaps;
@@ -203,8 +208,13 @@ Mesh mesh_assembly(const Assembly& assembly, double mesh_size, int order, const 
     if (solid_below == solid_above) throw std::logic_error("robot geometry: cannot orient a boundary surface");
     const bool faces_down = s.axis == 2 && solid_above;
     surface_tags[faces_down ? "bottom" : "outer"].push_back(tag);
-    if (faces_down && std::abs(s.nodes.hi.z() - assembly.foot_z) <= tol &&
-        std::abs(s.nodes.lo.z() - assembly.foot_z) <= tol) {
+    const bool in_foot_plane = faces_down && std::abs(s.nodes.hi.z() - assembly.foot_z) <= tol &&
+                               std::abs(s.nodes.lo.z() - assembly.foot_z) <= tol;
+    // A side or end face of the foot layer: when the body arches it stands on the
+    // foot's outer edge, whose friction must then be the foot's, not the skin's.
+    const bool foot_layer_side = !bladder && s.axis != 2 && assembly.foot_top_z > assembly.foot_z + tol &&
+                                 s.nodes.lo.z() >= assembly.foot_z - tol && s.nodes.hi.z() <= assembly.foot_top_z + tol;
+    if (in_foot_plane || foot_layer_side) {
       if (s.nodes.hi.y() <= assembly.foot_length + tol) {
         surface_tags["foot_a"].push_back(tag);
         foot = true;
@@ -329,6 +339,7 @@ Mesh build_robot_voxel(const ParamSet& params) {
   const double hb = c.bladder_thickness;
   const double z_core = hb + t, z_top = z_core + c.core_gap, z_upper = z_top + t;
   a.foot_z = hb;
+  a.foot_top_z = hb + t;  // the feet are the bottom layer's foot voxels (ROBOT.md)
   a.scale = std::max({c.width, c.length, z_upper + hb});
   add_split_layer(a, c.width, hb, z_core, "skin");
   add_core(a, c.width, c.edge, c.seal, z_core, z_top);

@@ -11,7 +11,9 @@
 // y ~ length), top skin layer, upper bladders. Bladders 1..4 are on top with
 // increasing x, 5..8 below with decreasing x, so 1..8 runs around the cross-section.
 // The feet are the bottom faces of the bottom skin layer at y in [0, foot_length]
-// (foot_a) and [length - foot_length, length] (foot_b).
+// (foot_a) and [length - foot_length, length] (foot_b); in robot_voxel also that
+// layer's end and side faces in those bands (the lattice's feet are whole voxels, and
+// an arched body stands on its feet's outer edges).
 //
 // Common parameters: mesh_size [m] (required), order (1 or 2, default 1).
 //
@@ -26,7 +28,8 @@
 //   Volumes: skin (both layers and the bonding strips), bladder_1 .. bladder_8 (solid).
 //   Surfaces: core_wall (closed inner boundary of the core gap), bottom (every
 //   downward-facing outer face: lower-bladder bottoms at z = 0 and uncovered skin
-//   bottom, feet included), foot_a, foot_b (also in bottom), outer (the rest of the
+//   bottom, feet included), foot_a, foot_b (bottom faces in bottom, end and side faces
+//   in outer), outer (the rest of the
 //   outer boundary). core_wall, bottom and outer together hold every boundary face once.
 //   end_a, end_b (also in outer): the end faces at y = 0 and y = length (a short slice
 //   with u_y = 0 on both is the mid-length cross-section in plane strain).

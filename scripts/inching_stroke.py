@@ -12,9 +12,14 @@ After `--start` (the end of settling) it prints
   * each foot's largest pull |F_y| / N over the saved steps after `--start` (friction
     force along the body over normal force, summed over the foot's nodes): a foot
     slides only when its pull reaches its friction coefficient.
-Used for the physical inching ladder in the README.
+With --steps it first prints, per saved step after `--start`, each foot's friction force
+along y [N] and normal force [N] and the force on the rest of the body, so one sees which
+foot anchors in which column.
+Used for the physical inching ladder in the README, and (--foot 0.03 --pad 0.0041
+--steps: the voxel preset's feet are the bottom skin layer's ends at z = 4 mm) for the
+voxel preset's feet.
 
-    /usr/bin/python3 scripts/inching_stroke.py RESULTS/CASE.h5 [--start 1.0] [--foot 0.02] [--pad 0.004]
+    /usr/bin/python3 scripts/inching_stroke.py RESULTS/CASE.h5 [--start 1.0] [--foot 0.02] [--pad 0.004] [--steps]
 """
 import argparse
 import sys
@@ -30,6 +35,7 @@ def main():
     parser.add_argument("--start", type=float, default=1.0, help="end of settling [s] (default 1.0)")
     parser.add_argument("--foot", type=float, default=0.02, help="foot length along y [m] (default 0.02)")
     parser.add_argument("--pad", type=float, default=0.004, help="foot pad height [m] (default 0.004)")
+    parser.add_argument("--steps", action="store_true", help="print each foot's forces per saved step")
     args = parser.parse_args()
     try:
         f = h5py.File(args.h5, "r")
@@ -51,6 +57,9 @@ def main():
         sys.exit(f"inching_stroke.py: {args.h5}: no saved step after --start {args.start} s")
     distance, ya, yb, belly_z = [], [], [], []
     pull = {"A": 0.0, "B": 0.0}
+    rest = ~(foot_a | foot_b)
+    if args.steps:
+        print("t [s]   foot A: F_y [N]  N [N]   foot B: F_y [N]  N [N]   rest: F_y [N]  N [N]")
     for k, s in enumerate(steps):
         g = f["/steps/" + s]
         if later[k] and "friction_force_N" in g and "contact_force_N" in g:
@@ -59,6 +68,11 @@ def main():
                 n = np.linalg.norm(normal[foot], axis=1).sum()
                 if n > 0:
                     pull[name] = max(pull[name], abs(friction[foot, 1].sum()) / n)
+            if args.steps:
+                row = [f"{times[k]:6.2f}"]
+                for part in (foot_a, foot_b, rest):
+                    row.append(f"{friction[part, 1].sum():14.3f} {np.linalg.norm(normal[part], axis=1).sum():6.2f}")
+                print("  ".join(row))
         x = X + f["/steps/" + s + "/displacement"][:]
         ya.append(x[foot_a, 1].mean())
         yb.append(x[foot_b, 1].mean())

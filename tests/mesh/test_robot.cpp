@@ -117,6 +117,33 @@ constexpr double kBw = 0.03, kBy0 = 0.03, kBy1 = 0.19, kFoot = 0.03;
 
 // "bottom": the lower bladders' bottoms at z = 0 and the uncovered skin bottom at
 // z = kHb, all facing down.
+// The voxel preset's feet: every face lies in the bottom layer's foot band
+// [0, kW] x [y0, y1] x [kHb, kHb + kT] on its outside (x = 0 or kW, y = 0 or kL, or
+// z = kHb facing down), and the downward ones have the band's area.
+void expect_foot_voxels(const Mesh& mesh, const std::string& surface, double y0, double y1) {
+  ASSERT_FALSE(mesh.faces_of(surface).empty()) << surface;
+  double down = 0.0;
+  for (int f : mesh.faces_of(surface)) {
+    const Vec3 n = face_area_normal(mesh, f);
+    Vec3 lo = Vec3::Constant(1e9), hi = Vec3::Constant(-1e9);
+    for (int k = 0; k < mesh.nodes_per_face(); ++k) {
+      const Vec3 x = node(mesh, mesh.faces(f, k));
+      lo = lo.cwiseMin(x);
+      hi = hi.cwiseMax(x);
+    }
+    EXPECT_GE(lo.y(), y0 - 1e-12) << surface << " face " << f;
+    EXPECT_LE(hi.y(), y1 + 1e-12) << surface << " face " << f;
+    EXPECT_GE(lo.z(), kHb - 1e-12) << surface << " face " << f;
+    EXPECT_LE(hi.z(), kHb + kT + 1e-12) << surface << " face " << f;
+    const bool bottom = hi.z() < kHb + 1e-12 && n.normalized().z() < -1.0 + 1e-12;
+    const bool side = (hi.x() < 1e-12 || lo.x() > kW - 1e-12) && std::abs(n.normalized().x()) > 1.0 - 1e-12;
+    const bool end = (hi.y() < 1e-12 || lo.y() > kL - 1e-12) && std::abs(n.normalized().y()) > 1.0 - 1e-12;
+    EXPECT_TRUE(bottom || side || end) << surface << " face " << f << " is not on the foot voxels' outside";
+    if (bottom) down += n.norm();
+  }
+  EXPECT_NEAR(down, kW * (y1 - y0), 1e-12) << surface;
+}
+
 void expect_bottom_levels(const Mesh& mesh) {
   double at_ground = 0.0, at_skin = 0.0;
   for (int f : mesh.faces_of("bottom")) {
@@ -164,12 +191,15 @@ void expect_voxel_robot(const Mesh& mesh) {
   const double block_faces = 2 * kBw * (kBy1 - kBy0) + 2 * (kBy1 - kBy0) * kHb + 2 * kBw * kHb;
   EXPECT_NEAR(area(mesh, "bladder_surface"), 8 * (block_faces - kBw * (kBy1 - kBy0)), 1e-12);
 
-  // Feet in the skin's bottom plane; bottom = lower bladders' bottoms + uncovered skin
-  // bottom, which together cover the footprint once.
-  expect_downward_in_plane(mesh, "foot_a", kHb, 0.0, kFoot);
-  expect_downward_in_plane(mesh, "foot_b", kHb, kL - kFoot, kL);
-  EXPECT_NEAR(area(mesh, "foot_a"), kW * kFoot, 1e-12);
-  EXPECT_NEAR(area(mesh, "foot_b"), kW * kFoot, 1e-12);
+  // Feet: the outside of the bottom layer's foot voxels, its bottom face (in the skin's
+  // bottom plane), its end face and its two side faces; their downward part is the
+  // footprint's ends. bottom = lower bladders' bottoms + uncovered skin bottom, which
+  // together cover the footprint once.
+  expect_foot_voxels(mesh, "foot_a", 0.0, kFoot);
+  expect_foot_voxels(mesh, "foot_b", kL - kFoot, kL);
+  const double foot = kW * kFoot + kW * kT + 2 * kFoot * kT;
+  EXPECT_NEAR(area(mesh, "foot_a"), foot, 1e-12);
+  EXPECT_NEAR(area(mesh, "foot_b"), foot, 1e-12);
   EXPECT_NEAR(area(mesh, "bottom"), kW * kL, 1e-12);
   expect_bottom_levels(mesh);
   // The end faces: the sealed cross-section (two layers, the gap's seal) at y = 0 and y = L.
