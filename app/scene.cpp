@@ -220,7 +220,9 @@ Scene scene_from_yaml(const YAML::Node& root, const std::string& path) {
       out = int(q);
     };
     either("linear_solver", scene.solver.linear_solver, "mumps", "gamg");
-    either("hessian_projection", scene.solver.hessian_projection, "adaptive", "always");
+    std::string projection = "adaptive";
+    either("hessian_projection", projection, "adaptive", "always");
+    scene.solver.hessian_projection = projection == "always" ? HessianProjection::always : HessianProjection::adaptive;
     positive_integer("max_newton_its", scene.solver.max_newton_its);
     positive_integer("easy_newton_its", scene.solver.easy_newton_its);
     if (s["formulation"]) {

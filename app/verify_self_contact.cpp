@@ -241,7 +241,8 @@ TubeVacuumResult run_tube_vacuum(double h, int order, MPI_Comm comm, bool progre
   // positive near equilibrium, and per-pair PSD projection in every iteration makes
   // Newton converge only linearly (measured: many steps stalled at 30 iterations).
   s.self_contact_spec.project_hessian = hessian == BarrierHessian::adaptive;
-  s.solver.hessian_projection = hessian == BarrierHessian::adaptive ? "adaptive" : "always";
+  s.solver.hessian_projection =
+      hessian == BarrierHessian::adaptive ? HessianProjection::adaptive : HessianProjection::always;
   s.solver.t_end = 1.0;
   s.solver.dt_initial = 0.02;
   s.solver.dt_max = 0.1;

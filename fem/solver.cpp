@@ -52,9 +52,6 @@ PetscErrorCode convergence_trampoline(SNES snes, PetscInt it, PetscReal, PetscRe
 
 QuasiStaticSolver::QuasiStaticSolver(Assembler& assembler, std::vector<DirichletCondition> bcs, SolverOptions options)
     : assembler_(assembler), bcs_(std::move(bcs)), opt_(std::move(options)) {
-  if (opt_.hessian_projection != "adaptive" && opt_.hessian_projection != "always")
-    throw InputError("solver.hessian_projection",
-                     "unknown Hessian projection '" + opt_.hessian_projection + "' (allowed: adaptive, always)");
   PETSC_CHECK(PetscOptionsGetBool(nullptr, nullptr, "-morphfem_linesearch_monitor", &linesearch_monitor_, nullptr));
   std::vector<int> dofs;
   for (const auto& bc : bcs_)
@@ -382,7 +379,7 @@ PetscErrorCode QuasiStaticSolver::line_search(SNESLineSearch ls) {
   }
   // Adaptive projection: a full Newton step (not backtracked, not bounded by a
   // term's max_step) makes the next iteration exact.
-  exact_hessian_ = opt_.hessian_projection == "adaptive" && lambda == 1.0;
+  exact_hessian_ = opt_.hessian_projection == HessianProjection::adaptive && lambda == 1.0;
   PetscCall(SNESLineSearchSetLambda(ls, lambda));
   PetscCall(VecCopy(W, X));
   PetscCall(SNESComputeFunction(snes, X, F));

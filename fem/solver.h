@@ -30,6 +30,9 @@ struct DirichletCondition {
   std::function<Eigen::Vector3d(const Eigen::Vector3d& X, double t)> value;
 };
 
+// How the Newton Hessian treats energy terms that can project theirs to PSD (below).
+enum class HessianProjection { adaptive, always };
+
 struct SolverOptions {
   double t_end = 1.0;       // end of the pseudo-time [s]
   double dt_initial = 0.1;  // first step [s]
@@ -42,16 +45,16 @@ struct SolverOptions {
   double rtol = 1e-9;                   // ||r|| <= rtol ||r_0|| ...
   double atol_factor = 1e-11;           // ... or ||r|| <= atol_factor * (largest ||r_0|| seen)
   std::string linear_solver = "mumps";  // "mumps" | "gamg"
-  // "always": terms that project their Hessian to PSD (EnergyTerm::set_exact_hessian)
-  // always do. "adaptive": the first iteration of a solve and every one after a
+  // always: terms that project their Hessian to PSD (EnergyTerm::set_exact_hessian)
+  // always do. adaptive: the first iteration of a solve and every one after a
   // damped (backtracked or CCD-bounded) step are projected; after a full Newton step
   // the next is exact, and if its direction does not descend, or the line search
   // finds no decrease along it, the line search re-solves with the projected
   // Hessian. Projection makes the Newton tail linear (the residual halving per
   // iteration on the rolling sleeve with self-contact); the exact Hessian restores
   // quadratic convergence where it is positive definite.
-  std::string hessian_projection = "adaptive";  // README, "stalled on the Hessian's projection"
-  std::vector<double> output_times;             // steps land exactly on these times
+  HessianProjection hessian_projection = HessianProjection::adaptive;  // README, "stalled on the Hessian's projection"
+  std::vector<double> output_times;                                    // steps land exactly on these times
 };
 
 struct StepReport {

@@ -116,7 +116,7 @@ TEST(Scene, BadSolverChoicesNameTheKeyAndTheAllowedValues) {
   TempScene s(
       replace(kGood, "solver: {end_time: 1", "solver: {hessian_projection: always, easy_newton_its: 9, end_time: 1"));
   const Scene scene = read_scene(s.file.string());
-  EXPECT_EQ(scene.solver.hessian_projection, "always");
+  EXPECT_EQ(scene.solver.hessian_projection, HessianProjection::always);
   EXPECT_EQ(scene.solver.easy_newton_its, 9);
 }
 

@@ -56,7 +56,7 @@ struct Outcome {
   double error = 0;  // max |u_a - d_a| at t = 1 [m]
 };
 
-Outcome solve(const std::string& projection, double exact_scale) {
+Outcome solve(HessianProjection projection, double exact_scale) {
   const Mesh mesh = morphfem::testing::block_mesh({1, 1, 1}, 0.5, 1);
   const Partition part = morphfem::testing::one_rank(mesh);
   Assembler assembler(mesh, part, PETSC_COMM_SELF);
@@ -76,7 +76,7 @@ Outcome solve(const std::string& projection, double exact_scale) {
 }  // namespace
 
 TEST(QuasiStaticSolver, AdaptiveProjectionFallsBackWhereTheExactHessianFails) {
-  const Outcome always = solve("always", -1.0);  // "always" never asks for the exact Hessian
+  const Outcome always = solve(HessianProjection::always, -1.0);  // "always" never asks for the exact Hessian
   ASSERT_TRUE(always.stats.completed) << always.stats.failure;
   EXPECT_EQ(always.stats.steps, 1);
   EXPECT_GT(always.stats.newton_its, 3);  // several iterations: the exact switch gets its chance
@@ -85,7 +85,7 @@ TEST(QuasiStaticSolver, AdaptiveProjectionFallsBackWhereTheExactHessianFails) {
   EXPECT_LT(always.error, 1e-8);
   for (double scale : {-1.0, 1e-14}) {
     SCOPED_TRACE(scale);
-    const Outcome adaptive = solve("adaptive", scale);
+    const Outcome adaptive = solve(HessianProjection::adaptive, scale);
     ASSERT_TRUE(adaptive.stats.completed) << adaptive.stats.failure;
     EXPECT_EQ(adaptive.stats.step_cuts, 0);
     EXPECT_LT(adaptive.error, 1e-8);
@@ -95,7 +95,7 @@ TEST(QuasiStaticSolver, AdaptiveProjectionFallsBackWhereTheExactHessianFails) {
     EXPECT_EQ(adaptive.stats.newton_its, always.stats.newton_its);
   }
   // The exact Hessian right (scale 1): exact iterations, no fallback, no more iterations.
-  const Outcome exact = solve("adaptive", 1.0);
+  const Outcome exact = solve(HessianProjection::adaptive, 1.0);
   ASSERT_TRUE(exact.stats.completed) << exact.stats.failure;
   EXPECT_GT(exact.stats.exact_hessian_its, 0);
   EXPECT_EQ(exact.stats.projection_fallbacks, 0);
