@@ -10,10 +10,10 @@ body is (1: a cylinder). Used for the voxel rolling slice table in the README.
 """
 import argparse
 import sys
-import xml.etree.ElementTree as ET
 
-import h5py
 import numpy as np
+
+from morphfem_result import open_result
 
 
 def main():
@@ -22,19 +22,12 @@ def main():
     parser.add_argument("time", type=float, help="time [s]; the nearest saved step is used")
     parser.add_argument("--region", type=int, default=0, help="volume region id of the skin (default 0)")
     args = parser.parse_args()
-    try:
-        f = h5py.File(args.h5, "r")
-        times = [float(t.get("Value")) for t in ET.parse(args.h5[:-3] + ".xdmf").iter("Time")]
-        X = f["/mesh/X"][:]
-        cells = f["/mesh/cells"][:]
-        region = f["/mesh/cell_region"][:]
-        steps = sorted(f["/steps"].keys())
-    except (OSError, KeyError, ET.ParseError) as e:
-        sys.exit(f"cross_section_shape.py: {args.h5}: not a morphfem result ({e})")
+    r = open_result(args.h5, "cross_section_shape.py")
+    times, X, cells, region = r.times, r.X, r.cells, r.region
     if not (region == args.region).any():
         sys.exit(f"cross_section_shape.py: {args.h5}: no cells in region {args.region}")
     i = int(np.argmin([abs(t - args.time) for t in times]))
-    x = X + f["/steps/" + steps[i] + "/displacement"][:]
+    x = r.deformed(i)
     skin = np.unique(cells[region == args.region][:, :4])
     y = X[:, 1]
     mid = np.where(np.abs(y - 0.5 * (y.min() + y.max())) < 0.011)[0]

@@ -20,10 +20,10 @@ non-locking body into a ring).
 """
 import argparse
 import sys
-import xml.etree.ElementTree as ET
 
-import h5py
 import numpy as np
+
+from morphfem_result import open_result
 
 
 def curl_deg(points):
@@ -48,16 +48,8 @@ def main():
         sys.exit("side_profile.py: --bins must be at least 3 and --every at least 1")
     if args.png and not args.at:
         sys.exit("side_profile.py: --png needs the times of the views (--at T1 T2 ...)")
-    try:
-        f = h5py.File(args.h5, "r")
-        times = np.array([float(t.get("Value")) for t in ET.parse(args.h5[:-3] + ".xdmf").iter("Time")])
-        X = f["/mesh/X"][:]
-        cells = f["/mesh/cells"][:]
-        region = f["/mesh/cell_region"][:]
-        steps = sorted(f["/steps"].keys())
-    except (OSError, KeyError, ET.ParseError) as e:
-        sys.exit(f"side_profile.py: {args.h5}: not a morphfem result ({e})")
-    steps = steps[: len(times)]
+    r = open_result(args.h5, "side_profile.py")
+    times, X, cells, region, steps = r.times, r.X, r.cells, r.region, r.steps
     skin = np.zeros(len(X), bool)
     skin[np.unique(cells[region == 0])] = True
     x_mid = 0.5 * (X[:, 0].min() + X[:, 0].max())
@@ -67,15 +59,12 @@ def main():
     if any(not s.any() for s in slices):
         sys.exit(f"side_profile.py: {args.h5}: a slice has no skin node; use fewer --bins or a wider --band")
 
-    def deformed(k):
-        return X + f["/steps/" + steps[k] + "/displacement"][:]
-
     print("t [s]   curl [deg]   top z [mm]   end-to-end [mm]")
     largest = (0.0, 0.0)
     for k in range(len(steps)):
         if times[k] < args.start or times[k] > args.end:
             continue
-        x = deformed(k)
+        x = r.deformed(k)
         centres = np.array([x[s][:, 1:].mean(axis=0) for s in slices])
         curl = curl_deg(centres)
         if abs(curl) > abs(largest[0]):
@@ -97,7 +86,7 @@ def main():
         fig, axes = plt.subplots(1, len(args.at), figsize=(4 * len(args.at), 3.6), squeeze=False)
         for ax, t in zip(axes[0], args.at):
             k = int(np.argmin(np.abs(times - t)))
-            x = deformed(k)
+            x = r.deformed(k)
             for part, colour, name in ((mid & skin, "tab:blue", "skin"), (mid & other & ~skin, "tab:orange", "other")):
                 ax.scatter(1e3 * x[part, 1], 1e3 * x[part, 2], s=2, c=colour, label=name)
             centres = np.array([x[s][:, 1:].mean(axis=0) for s in slices])
