@@ -44,6 +44,11 @@ const char* kRobotUsage =
     "  ladder --case NAME [--levels 0,1,2] [--out DIR]\n"
     "        one case on several fidelity levels: speed against wall time, and the\n"
     "        cheapest level within 5 % of the finest\n"
+    "  spread --case NAME --vary KEY=V1,V2,... [--levels 0,...] [--preset voxel|physical]\n"
+    "         [--out DIR] [--set KEY=VALUE ...]\n"
+    "        one case run once per value of one scene key (a perturbation ensemble, e.g.\n"
+    "        --vary environment.heading_deg=-1,-0.5,0,0.5,1), on each level: every speed, their\n"
+    "        mean, standard deviation and range, and whether the levels' means agree; JSON, PNG\n"
     "  morph [--scene FILE] [--out DIR] [--set KEY=VALUE ...]\n"
     "        shape change under core pressure (default examples/voxel/morph.yaml): width /\n"
     "        thickness of the mid-length cross-section against core pressure, table, CSV, PNG\n"
@@ -325,17 +330,8 @@ void register_robot_fitness() {
       "finite-element robot, voxel-study preset with growth actuation (levels: morphfem robot levels)");
 }
 
-namespace {
-
-struct CaseOutcome {
-  double speed = 0, displacement = 0, wall_s = 0, dofs = 0, steps = 0, newton = 0, completed = 0;
-  static constexpr int kFields = 7;
-};
-
-// Runs jobs (case, level) round-robin over the ranks of `comm`, one rank per job;
-// every rank returns every outcome (in job order).
-std::vector<CaseOutcome> run_jobs(const std::vector<std::pair<RobotCase, RobotFidelity>>& jobs,
-                                  const std::string& out_dir, MPI_Comm comm) {
+std::vector<CaseOutcome> run_robot_jobs(const std::vector<std::pair<RobotCase, RobotFidelity>>& jobs,
+                                        const std::string& out_dir, MPI_Comm comm) {
   int rank = 0, size = 1;
   MPI_Comm_rank(comm, &rank);
   MPI_Comm_size(comm, &size);
@@ -397,6 +393,8 @@ Json outcome_json(const RobotCase& c, const RobotFidelity& level, const CaseOutc
   return j;
 }
 
+namespace {
+
 int validate(const std::vector<std::string>& args, MPI_Comm comm) {
   check_options(args, {"--fidelity", "--cases", "--out", "--set", "--set-physical", "--set-physical-round",
                        "--set-physical-flat", "--presets"});
@@ -430,7 +428,7 @@ int validate(const std::vector<std::string>& args, MPI_Comm comm) {
   for (const auto& name : names)
     for (const auto& c : physical_cases)
       if (physical && c.name == name) jobs.emplace_back(c, level);
-  const auto outcomes = run_jobs(jobs, out_dir, comm);
+  const auto outcomes = run_robot_jobs(jobs, out_dir, comm);
   int rank = 0;
   MPI_Comm_rank(comm, &rank);
   if (rank != 0) return 0;
@@ -503,7 +501,7 @@ int ladder(const std::vector<std::string>& args, MPI_Comm comm) {
   const std::string out_dir = option(args, "--out", "results/robot/ladder");
   std::vector<std::pair<RobotCase, RobotFidelity>> jobs;
   for (const auto& l : split(option(args, "--levels", "0,1,2"))) jobs.emplace_back(c, find_robot_fidelity(l));
-  const auto outcomes = run_jobs(jobs, out_dir, comm);
+  const auto outcomes = run_robot_jobs(jobs, out_dir, comm);
   int rank = 0;
   MPI_Comm_rank(comm, &rank);
   if (rank != 0) return 0;
@@ -588,7 +586,7 @@ int friction_sweep(const std::vector<std::string>& args, MPI_Comm comm) {
     c.voxel_bl_per_s = voxel;
     jobs.emplace_back(c, level);
   }
-  const auto outcomes = run_jobs(jobs, out_dir, comm);
+  const auto outcomes = run_robot_jobs(jobs, out_dir, comm);
   int rank = 0;
   MPI_Comm_rank(comm, &rank);
   if (rank != 0) return 0;
@@ -709,6 +707,7 @@ int robot_main(const std::vector<std::string>& args, MPI_Comm comm) {
   if (args[0] == "friction-sweep") return friction_sweep(args, comm);
   if (args[0] == "benchmark") return benchmark(args, comm);
   if (args[0] == "friction-drag") return robot_friction_drag(args, comm);
+  if (args[0] == "spread") return robot_spread(args, comm);
   if (args[0] == "levels") {
     for (const auto& l : robot_fidelity_levels())
       std::printf("level %s: mesh_size %.4g m, P%d, max_step %.4g s\n", l.name.c_str(), l.mesh_size, l.order,

@@ -22,12 +22,15 @@
 #pragma once
 #include <mpi.h>
 
+#include <cmath>
 #include <limits>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "actuation/schedule.h"
 #include "app/simulation.h"
+#include "core/json.h"
 
 namespace morphfem {
 
@@ -104,6 +107,23 @@ void register_robot_fitness();
 // length of its middle (reference y), away from the sealed ends that stay flat.
 Eigen::Vector3d cross_section_extents(const Mesh& mesh, const RowMatrixXd& u);
 
+// What a robot run reports to the commands that run many (validate, ladder,
+// friction-sweep, spread); completed = 1 if the run and its gait finished.
+struct CaseOutcome {
+  double speed = 0, displacement = 0, wall_s = 0, dofs = 0, steps = 0, newton = 0, completed = 0;
+  static constexpr int kFields = 7;
+};
+// Runs jobs (case, level) round-robin over the ranks of `comm`, one rank per job, each
+// writing into OUT_DIR/NAME_LLEVEL (physical cases: OUT_DIR/NAME_physical; nothing if
+// out_dir is empty); every rank returns every outcome, in job order. A progress bar
+// with ETA on rank 0.
+std::vector<CaseOutcome> run_robot_jobs(const std::vector<std::pair<RobotCase, RobotFidelity>>& jobs,
+                                        const std::string& out_dir, MPI_Comm comm);
+// The case called `name` (InputError on --case naming the known ones otherwise).
+const RobotCase& find_case(const std::vector<RobotCase>& cases, const std::string& name);
+// One row of a command's JSON summary: the case, its level and its outcome.
+Json outcome_json(const RobotCase& c, const RobotFidelity& level, const CaseOutcome& o);
+
 // Command-line helpers of `morphfem robot COMMAND` (args[0] = COMMAND, then option
 // value pairs): the value of an option (or the fallback), every value of a repeatable
 // option, a comma-separated list, and a check that every option is known and has a
@@ -115,6 +135,27 @@ void check_options(const std::vector<std::string>& args, const std::vector<std::
 
 // `morphfem robot friction-drag` (app/robot_drag.cpp): the pull test on a robot scene.
 int robot_friction_drag(const std::vector<std::string>& args, MPI_Comm comm);
+
+// `--vary KEY=V1,V2,...` of `robot spread`: the scene key and its values, as given (each
+// run sets KEY=V). InputError if it is not KEY=..., has fewer than two values, or
+// repeats a value.
+std::pair<std::string, std::vector<std::string>> parse_variation(const std::string& spec);
+// The speeds of an ensemble of runs: n completed (failed ones left out), mean, sample
+// standard deviation sqrt(sum (v - mean)^2 / (n - 1)) (NaN for n < 2), range, how many
+// moved forward (v > 0). [BL/s]
+struct SpreadStats {
+  int n = 0, failed = 0, forward = 0;
+  double mean = std::numeric_limits<double>::quiet_NaN(), std = std::numeric_limits<double>::quiet_NaN();
+  double min = std::numeric_limits<double>::quiet_NaN(), max = std::numeric_limits<double>::quiet_NaN();
+  // std / sqrt(n): the standard error of the mean (NaN for n < 2).
+  double standard_error() const { return n > 1 ? std / std::sqrt(static_cast<double>(n)) : std; }
+};
+SpreadStats spread_stats(const std::vector<CaseOutcome>& runs);
+
+// `morphfem robot spread` (app/robot_spread.cpp): one case run several times with one
+// scene key varied (a perturbation ensemble), per fidelity level: the speeds' mean,
+// standard deviation and range, for gaits whose single-run speed is chaotic.
+int robot_spread(const std::vector<std::string>& args, MPI_Comm comm);
 
 // `morphfem robot validate|ladder ...` (usage in robot_study.cpp).
 int robot_main(const std::vector<std::string>& args, MPI_Comm comm);

@@ -1,0 +1,102 @@
+// `morphfem robot spread` (app/robot_spread.cpp): the --vary parser, the ensemble
+// statistics, and one cheap ensemble end to end (the varied key reaches every run).
+#include <gtest/gtest.h>
+#include <petscsys.h>
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <filesystem>
+
+#include "app/robot_study.h"
+#include "core/errors.h"
+#include "temp_dir.h"
+
+using namespace morphfem;
+
+TEST(RobotSpread, VaryIsAKeyAndTwoOrMoreDistinctValues) {
+  const auto [key, values] = parse_variation("environment.heading_deg=-1,-0.5,0,0.5,1");
+  EXPECT_EQ(key, "environment.heading_deg");
+  ASSERT_EQ(values.size(), 5u);
+  EXPECT_EQ(values[0], "-1");
+  EXPECT_EQ(values[4], "1");
+  EXPECT_THROW(parse_variation("environment.heading_deg"), InputError);  // no '='
+  EXPECT_THROW(parse_variation("=1,2"), InputError);                     // no key
+  EXPECT_THROW(parse_variation("solver.max_step=0.1"), InputError);      // one value is no spread
+  EXPECT_THROW(parse_variation("solver.max_step=0.1,0.05,0.1"), InputError);  // repeated value
+  try {
+    parse_variation("solver.max_step=0.1");
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("--vary solver.max_step"), std::string::npos) << e.what();
+  }
+}
+
+TEST(RobotSpread, StatisticsLeaveFailedRunsOut) {
+  auto run = [](double v, bool ok) {
+    CaseOutcome o;
+    o.speed = v;
+    o.completed = ok ? 1 : 0;
+    return o;
+  };
+  // Completed: -1, 2, 3, 4 -> mean 2, sum of squares 9 + 0 + 1 + 4 = 14, std sqrt(14/3).
+  const SpreadStats s = spread_stats({run(-1, true), run(2, true), run(100, false), run(3, true), run(4, true)});
+  EXPECT_EQ(s.n, 4);
+  EXPECT_EQ(s.failed, 1);
+  EXPECT_EQ(s.forward, 3);
+  EXPECT_DOUBLE_EQ(s.mean, 2.0);
+  EXPECT_NEAR(s.std, std::sqrt(14.0 / 3.0), 1e-14);
+  EXPECT_NEAR(s.standard_error(), std::sqrt(14.0 / 3.0) / 2.0, 1e-14);
+  EXPECT_DOUBLE_EQ(s.min, -1.0);
+  EXPECT_DOUBLE_EQ(s.max, 4.0);
+  const SpreadStats one = spread_stats({run(0.5, true)});
+  EXPECT_EQ(one.n, 1);
+  EXPECT_TRUE(std::isnan(one.std));
+  const SpreadStats none = spread_stats({run(1, false)});
+  EXPECT_EQ(none.n, 0);
+  EXPECT_TRUE(std::isnan(none.mean));
+}
+
+TEST(RobotSpread, BadCommandLinesAreRefused) {
+  EXPECT_THROW(robot_spread({"spread", "--case", "roll_flat"}, PETSC_COMM_WORLD), InputError);  // no --vary
+  EXPECT_THROW(robot_spread({"spread", "--case", "no_such_case", "--vary", "solver.max_step=0.1,0.05"},
+                            PETSC_COMM_WORLD),
+               InputError);
+  EXPECT_THROW(robot_spread({"spread", "--case", "roll_flat", "--vary", "solver.max_step=0.1,0.05", "--preset",
+                             "lattice"},
+                            PETSC_COMM_WORLD),
+               InputError);
+  EXPECT_THROW(robot_spread({"spread", "--case", "roll_flat", "--vary", "solver.max_step=0.1,0.05", "--preset",
+                             "physical", "--levels", "0"},
+                            PETSC_COMM_WORLD),
+               InputError);
+}
+
+// The cheapest case (empty schedule, flat, level 0, about 20 s a run) with the largest
+// time step varied: each run must have taken its own value (different step counts),
+// both must stay put (|v| < 0.005 BL/s, the bound), and the summary's
+// statistics must be those of the runs it lists.
+TEST(RobotSpread, EnsembleRunsEachValueAndSummarisesThem) {
+  const auto dir = temp_dir("robot_spread");
+  ASSERT_EQ(robot_spread({"spread", "--case", "empty_0deg_0kPa_flat", "--vary", "solver.max_step=0.1,0.2", "--out",
+                          dir.string()},
+                         PETSC_COMM_WORLD),
+            0);
+  int rank = 0;
+  MPI_Comm_rank(PETSC_COMM_WORLD, &rank);
+  if (rank != 0) return;
+  const YAML::Node summary = YAML::LoadFile((dir / "empty_0deg_0kPa_flat_spread.json").string());
+  EXPECT_EQ(summary["varied_key"].as<std::string>(), "solver.max_step");
+  ASSERT_EQ(summary["levels"].size(), 1u);
+  const YAML::Node level = summary["levels"][0];
+  EXPECT_EQ(level["n"].as<int>(), 2);
+  EXPECT_EQ(level["failed"].as<int>(), 0);
+  const YAML::Node runs = level["runs"];
+  ASSERT_EQ(runs.size(), 2u);
+  EXPECT_EQ(runs[0]["value"].as<std::string>(), "0.1");
+  EXPECT_NE(runs[0]["steps"].as<double>(), runs[1]["steps"].as<double>());
+  const double v0 = runs[0]["speed_bl_per_s"].as<double>(), v1 = runs[1]["speed_bl_per_s"].as<double>();
+  EXPECT_LT(std::abs(v0), 0.005);
+  EXPECT_LT(std::abs(v1), 0.005);
+  EXPECT_NEAR(level["mean_bl_per_s"].as<double>(), 0.5 * (v0 + v1), 1e-12);
+  EXPECT_NEAR(level["std_bl_per_s"].as<double>(), std::abs(v0 - v1) / std::sqrt(2.0), 1e-12);
+  for (const auto& r : runs) EXPECT_TRUE(std::filesystem::exists(dir / r["folder"].as<std::string>() / "scene.yaml"));
+}
