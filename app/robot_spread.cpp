@@ -78,21 +78,23 @@ int robot_spread(const std::vector<std::string>& args, MPI_Comm comm) {
   const std::string name = option(args, "--case", "");
   const std::string spec = option(args, "--vary", "");
   if (name.empty() || spec.empty())
-    throw InputError("morphfem robot spread", std::string("needs --case NAME and --vary KEY=V1,V2,...\n") +
-                                                  kSpreadUsage);
+    throw InputError("morphfem robot spread",
+                     std::string("needs --case NAME and --vary KEY=V1,V2,...\n") + kSpreadUsage);
   const auto [key, values] = parse_variation(spec);
   const std::string preset = option(args, "--preset", "voxel");
   if (preset != "voxel" && preset != "physical")
     throw InputError("--preset", "unknown preset '" + preset + "' (known: voxel, physical)");
   const bool physical = preset == "physical";
-  const auto cases = physical ? physical_baseline_cases(MORPHFEM_SOURCE_DIR) : voxel_baseline_cases(MORPHFEM_SOURCE_DIR);
+  const auto cases =
+      physical ? physical_baseline_cases(MORPHFEM_SOURCE_DIR) : voxel_baseline_cases(MORPHFEM_SOURCE_DIR);
   const RobotCase& base = find_case(cases, name);
   std::vector<RobotFidelity> levels;
   if (physical) {
     // The physical templates carry their own mesh and time step; a level would be ignored.
     if (!option(args, "--levels", "").empty())
-      throw InputError("--levels", "the physical preset runs its template's own mesh and time step: vary them with "
-                                   "--vary or --set (e.g. --vary solver.max_step=...)");
+      throw InputError("--levels",
+                       "the physical preset runs its template's own mesh and time step: vary them with "
+                       "--vary or --set (e.g. --vary solver.max_step=...)");
     RobotFidelity own;
     own.name = "template";
     levels.push_back(own);
@@ -134,8 +136,8 @@ int robot_spread(const std::vector<std::string>& args, MPI_Comm comm) {
       const CaseOutcome& o = mine[k];
       wall += o.wall_s;
       std::snprintf(line, sizeof line, "%-6s %-*s  %+10.5f  %+14.4f  %7.1f  %5.0f  %5.0f  %6.0f  %s\n",
-                    levels[l].name.c_str(), width, values[k].c_str(), o.speed, o.displacement, o.wall_s, o.dofs, o.steps,
-                    o.newton, o.completed > 0 ? "ok" : "FAILED");
+                    levels[l].name.c_str(), width, values[k].c_str(), o.speed, o.displacement, o.wall_s, o.dofs,
+                    o.steps, o.newton, o.completed > 0 ? "ok" : "FAILED");
       table += line;
       Json r = outcome_json(base, levels[l], o);
       const RobotCase& c = jobs[l * values.size() + k].first;
@@ -163,8 +165,9 @@ int robot_spread(const std::vector<std::string>& args, MPI_Comm comm) {
   }
 
   const SpreadStats& finest = stats.back();
-  table += "\nlevel   n  failed  forward       mean        std   std_err        min        max  mean_vs_finest  "
-           "within_2_se\n";
+  table +=
+      "\nlevel   n  failed  forward       mean        std   std_err        min        max  mean_vs_finest  "
+      "within_2_se\n";
   std::string pick = "none";
   for (size_t l = 0; l < levels.size(); ++l) {
     const SpreadStats& s = stats[l];
@@ -198,8 +201,8 @@ int robot_spread(const std::vector<std::string>& args, MPI_Comm comm) {
   write_file_atomic(json, summary.str(true) + "\n");
   write_file_atomic(out_dir + "/" + name + "_spread.txt", table);
   run_plot_script("plot_spread.py", {json}, "the spread");
-  std::printf("results: %s, %s/%s_spread.png, per run %s/%s_vK_%s/\n", json.c_str(), out_dir.c_str(),
-              name.c_str(), out_dir.c_str(), name.c_str(), physical ? "physical" : "LLEVEL");
+  std::printf("results: %s, %s/%s_spread.png, per run %s/%s_vK_%s/\n", json.c_str(), out_dir.c_str(), name.c_str(),
+              out_dir.c_str(), name.c_str(), physical ? "physical" : "LLEVEL");
   return 0;
 }
 

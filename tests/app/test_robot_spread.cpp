@@ -19,9 +19,9 @@ TEST(RobotSpread, VaryIsAKeyAndTwoOrMoreDistinctValues) {
   ASSERT_EQ(values.size(), 5u);
   EXPECT_EQ(values[0], "-1");
   EXPECT_EQ(values[4], "1");
-  EXPECT_THROW(parse_variation("environment.heading_deg"), InputError);  // no '='
-  EXPECT_THROW(parse_variation("=1,2"), InputError);                     // no key
-  EXPECT_THROW(parse_variation("solver.max_step=0.1"), InputError);      // one value is no spread
+  EXPECT_THROW(parse_variation("environment.heading_deg"), InputError);       // no '='
+  EXPECT_THROW(parse_variation("=1,2"), InputError);                          // no key
+  EXPECT_THROW(parse_variation("solver.max_step=0.1"), InputError);           // one value is no spread
   EXPECT_THROW(parse_variation("solver.max_step=0.1,0.05,0.1"), InputError);  // repeated value
   try {
     parse_variation("solver.max_step=0.1");
@@ -57,13 +57,13 @@ TEST(RobotSpread, StatisticsLeaveFailedRunsOut) {
 
 TEST(RobotSpread, BadCommandLinesAreRefused) {
   EXPECT_THROW(robot_spread({"spread", "--case", "roll_flat"}, PETSC_COMM_WORLD), InputError);  // no --vary
-  EXPECT_THROW(robot_spread({"spread", "--case", "no_such_case", "--vary", "solver.max_step=0.1,0.05"},
-                            PETSC_COMM_WORLD),
-               InputError);
-  EXPECT_THROW(robot_spread({"spread", "--case", "roll_flat", "--vary", "solver.max_step=0.1,0.05", "--preset",
-                             "lattice"},
-                            PETSC_COMM_WORLD),
-               InputError);
+  EXPECT_THROW(
+      robot_spread({"spread", "--case", "no_such_case", "--vary", "solver.max_step=0.1,0.05"}, PETSC_COMM_WORLD),
+      InputError);
+  EXPECT_THROW(
+      robot_spread({"spread", "--case", "roll_flat", "--vary", "solver.max_step=0.1,0.05", "--preset", "lattice"},
+                   PETSC_COMM_WORLD),
+      InputError);
   EXPECT_THROW(robot_spread({"spread", "--case", "roll_flat", "--vary", "solver.max_step=0.1,0.05", "--preset",
                              "physical", "--levels", "0"},
                             PETSC_COMM_WORLD),
