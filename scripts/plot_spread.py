@@ -2,11 +2,11 @@
 """A perturbation ensemble of one robot case (morphfem robot spread): every run's speed per
 fidelity level, with the level's mean and +- one sample standard deviation.
 
-usage: plot_spread.py CASE_spread.json [OUT.png]
+usage: plot_spread.py CASE_spread.json [--png OUT.png]   (default: CASE_spread.png beside the JSON)
 """
+import argparse
 import json
 import os
-import sys
 
 import matplotlib
 
@@ -15,11 +15,13 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 
 def main():
-    if len(sys.argv) < 2:
-        sys.exit(__doc__)
-    with open(sys.argv[1]) as f:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("summary", help="CASE_spread.json written by morphfem robot spread")
+    parser.add_argument("--png", help="output PNG (default: beside the JSON)")
+    args = parser.parse_args()
+    with open(args.summary) as f:
         spread = json.load(f)
-    out = sys.argv[2] if len(sys.argv) > 2 else os.path.splitext(sys.argv[1])[0] + ".png"
+    out = args.png or os.path.splitext(args.summary)[0] + ".png"
     fig, ax = plt.subplots(figsize=(6.4, 4.2))
     names = []
     for i, level in enumerate(spread["levels"]):
@@ -39,6 +41,7 @@ def main():
     if voxel is not None:
         ax.axhline(voxel, color="0.4", ls="--", lw=1, label="voxel study")
     ax.axhline(0, color="0.8", lw=0.8)
+    ax.set_xlim(-0.5, len(names) - 0.5)
     ax.set_xticks(range(len(names)))
     ax.set_xticklabels(names)
     ax.set_xlabel("fidelity level")
