@@ -67,8 +67,11 @@ SpreadStats spread_stats(const std::vector<CaseOutcome>& runs) {
   if (v.empty()) return s;
   s.mean = mean_of(v);
   s.std = v.size() > 1 ? sample_std(v) : NAN;
-  s.min = *std::min_element(v.begin(), v.end());
-  s.max = *std::max_element(v.begin(), v.end());
+  std::sort(v.begin(), v.end());
+  s.min = v.front();
+  s.max = v.back();
+  const size_t h = v.size() / 2;
+  s.median = v.size() % 2 ? v[h] : 0.5 * (v[h - 1] + v[h]);
   s.forward = static_cast<int>(std::count_if(v.begin(), v.end(), [](double x) { return x > 0; }));
   return s;
 }
@@ -157,6 +160,7 @@ int robot_spread(const std::vector<std::string>& args, MPI_Comm comm) {
         .add("mean_bl_per_s", s.mean)
         .add("std_bl_per_s", s.std)
         .add("standard_error_bl_per_s", s.standard_error())
+        .add("median_bl_per_s", s.median)
         .add("min_bl_per_s", s.min)
         .add("max_bl_per_s", s.max)
         .add("wall_s_total", wall)
@@ -166,7 +170,7 @@ int robot_spread(const std::vector<std::string>& args, MPI_Comm comm) {
 
   const SpreadStats& finest = stats.back();
   table +=
-      "\nlevel   n  failed  forward       mean        std   std_err        min        max  mean_vs_finest  "
+      "\nlevel   n  failed  forward       mean        std   std_err     median        min        max  mean_vs_finest  "
       "within_2_se\n";
   std::string pick = "none";
   for (size_t l = 0; l < levels.size(); ++l) {
@@ -175,8 +179,9 @@ int robot_spread(const std::vector<std::string>& args, MPI_Comm comm) {
     const double se_diff = std::sqrt(std::pow(s.standard_error(), 2) + std::pow(finest.standard_error(), 2));
     const bool within = std::abs(s.mean - finest.mean) <= 2 * se_diff;
     if (pick == "none" && s.failed == 0 && s.n > 0 && rel <= 0.05) pick = levels[l].name;
-    std::snprintf(line, sizeof line, "%-6s %2d  %6d  %7d  %+9.5f  %9.5f  %8.5f  %+9.5f  %+9.5f  %14.3f  %s\n",
-                  levels[l].name.c_str(), s.n, s.failed, s.forward, s.mean, s.std, s.standard_error(), s.min, s.max,
+    std::snprintf(line, sizeof line, "%-6s %2d  %6d  %7d  %+9.5f  %9.5f  %8.5f  %+9.5f  %+9.5f  %+9.5f  %14.3f  %s\n",
+                  levels[l].name.c_str(), s.n, s.failed, s.forward, s.mean, s.std, s.standard_error(), s.median, s.min,
+                  s.max,
                   rel, l + 1 == levels.size() ? "-" : (std::isfinite(se_diff) ? (within ? "yes" : "no") : "n/a"));
     table += line;
     Json& j = level_rows[l];

@@ -141,11 +141,13 @@ int robot_friction_drag(const std::vector<std::string>& args, MPI_Comm comm);
 // repeats a value.
 std::pair<std::string, std::vector<std::string>> parse_variation(const std::string& spec);
 // The speeds of an ensemble of runs: n completed (failed ones left out), mean, sample
-// standard deviation sqrt(sum (v - mean)^2 / (n - 1)) (NaN for n < 2), range, how many
-// moved forward (v > 0). [BL/s]
+// standard deviation sqrt(sum (v - mean)^2 / (n - 1)) (NaN for n < 2), median (the
+// middle value, or the mean of the two middle ones: robust to one run that tumbles
+// differently), range, how many moved forward (v > 0). [BL/s]
 struct SpreadStats {
   int n = 0, failed = 0, forward = 0;
   double mean = std::numeric_limits<double>::quiet_NaN(), std = std::numeric_limits<double>::quiet_NaN();
+  double median = std::numeric_limits<double>::quiet_NaN();
   double min = std::numeric_limits<double>::quiet_NaN(), max = std::numeric_limits<double>::quiet_NaN();
   // std / sqrt(n): the standard error of the mean (NaN for n < 2).
   double standard_error() const { return n > 1 ? std / std::sqrt(static_cast<double>(n)) : std; }

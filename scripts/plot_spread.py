@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """A perturbation ensemble of one robot case (morphfem robot spread): every run's speed per
-fidelity level, with the level's mean and +- one sample standard deviation.
+fidelity level, with the level's mean +- one sample standard deviation and its median.
 
 usage: plot_spread.py CASE_spread.json [--png OUT.png]   (default: CASE_spread.png beside the JSON)
 """
@@ -37,6 +37,9 @@ def main():
             std = level["std_bl_per_s"] or 0.0
             ax.errorbar(i + 0.15, level["mean_bl_per_s"], yerr=std, fmt="s", color="C1", capsize=4,
                         label="mean +- std" if i == 0 else None)
+        if level.get("median_bl_per_s") is not None:
+            ax.plot(i + 0.15, level["median_bl_per_s"], "_", color="C2", ms=16, mew=2,
+                    label="median" if i == 0 else None)
         voxel = level["runs"][0].get("voxel_bl_per_s") if level["runs"] else None
     if voxel is not None:
         ax.axhline(voxel, color="0.4", ls="--", lw=1, label="voxel study")

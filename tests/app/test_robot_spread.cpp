@@ -45,11 +45,15 @@ TEST(RobotSpread, StatisticsLeaveFailedRunsOut) {
   EXPECT_DOUBLE_EQ(s.mean, 2.0);
   EXPECT_NEAR(s.std, std::sqrt(14.0 / 3.0), 1e-14);
   EXPECT_NEAR(s.standard_error(), std::sqrt(14.0 / 3.0) / 2.0, 1e-14);
+  EXPECT_DOUBLE_EQ(s.median, 2.5);  // sorted -1, 2, 3, 4: the two middle ones' mean
   EXPECT_DOUBLE_EQ(s.min, -1.0);
   EXPECT_DOUBLE_EQ(s.max, 4.0);
   const SpreadStats one = spread_stats({run(0.5, true)});
   EXPECT_EQ(one.n, 1);
   EXPECT_TRUE(std::isnan(one.std));
+  EXPECT_DOUBLE_EQ(one.median, 0.5);
+  const SpreadStats odd = spread_stats({run(-2.3, true), run(-0.9, true), run(-1.0, true)});
+  EXPECT_DOUBLE_EQ(odd.median, -1.0);  // the outlier -2.3 moves the mean, not the median
   const SpreadStats none = spread_stats({run(1, false)});
   EXPECT_EQ(none.n, 0);
   EXPECT_TRUE(std::isnan(none.mean));
