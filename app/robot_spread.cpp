@@ -181,8 +181,8 @@ int robot_spread(const std::vector<std::string>& args, MPI_Comm comm) {
     if (pick == "none" && s.failed == 0 && s.n > 0 && rel <= 0.05) pick = levels[l].name;
     std::snprintf(line, sizeof line, "%-6s %2d  %6d  %7d  %+9.5f  %9.5f  %8.5f  %+9.5f  %+9.5f  %+9.5f  %14.3f  %s\n",
                   levels[l].name.c_str(), s.n, s.failed, s.forward, s.mean, s.std, s.standard_error(), s.median, s.min,
-                  s.max,
-                  rel, l + 1 == levels.size() ? "-" : (std::isfinite(se_diff) ? (within ? "yes" : "no") : "n/a"));
+                  s.max, rel,
+                  l + 1 == levels.size() ? "-" : (std::isfinite(se_diff) ? (within ? "yes" : "no") : "n/a"));
     table += line;
     Json& j = level_rows[l];
     j.add("mean_vs_finest", rel).add("mean_within_2_standard_errors_of_finest", within);
