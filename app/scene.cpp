@@ -453,7 +453,7 @@ Scene scene_from_yaml(const YAML::Node& root, const std::string& path) {
   }
 
   if (const auto c = root["contact"]) {
-    r.allow(c, "contact", {"ground", "friction", "self"});
+    r.allow(c, "contact", {"ground", "friction", "self", "lattice_floor"});
     if (const auto g = c["ground"]) {
       r.allow(g, "contact.ground", {"point", "normal", "surfaces", "dhat", "kappa"});
       scene.ground_contact = true;
@@ -493,6 +493,31 @@ Scene scene_from_yaml(const YAML::Node& root, const std::string& path) {
         region.mu_static = coefficient(ms, "contact.friction.regions.mu_static");
         region.mu_kinetic = coefficient(mk, "contact.friction.regions.mu_kinetic");
         scene.friction_spec.regions.push_back(region);
+      }
+    }
+    if (const auto lf = c["lattice_floor"]) {
+      const std::string key = "contact.lattice_floor";
+      r.allow(lf, key, {"point", "normal", "dhat", "kappa", "eps_v", "voxel_size", "mu"});
+      scene.lattice_floor = true;
+      LatticeFloorScene& spec = scene.lattice_floor_spec;
+      if (lf["point"]) spec.floor.point = r.vector3(lf["point"], key + ".point");
+      if (lf["normal"]) {
+        spec.floor.normal = r.vector3(lf["normal"], key + ".normal");
+        if (spec.floor.normal.norm() == 0) r.fail(lf["normal"], key + ".normal", "must not be zero");
+      }
+      for (auto [k, value] : {std::pair{"dhat", &spec.floor.dhat}, std::pair{"eps_v", &spec.floor.eps_v},
+                              std::pair{"voxel_size", &spec.voxel_size}})
+        r.optional_positive(lf, key, k, *value);
+      if (!lf["kappa"]) r.fail(lf, key, "missing key 'kappa' (the barrier stiffness [Pa])");
+      r.optional_positive(lf, key, "kappa", spec.floor.kappa);
+      const YAML::Node mu = lf["mu"];
+      if (!mu || !mu.IsMap() || mu.size() == 0)
+        r.fail(mu ? mu : lf, key + ".mu", "expected a map volume region -> friction coefficient, e.g. {skin: 2.0}");
+      for (const auto& item : mu) {
+        const std::string region = r.text(item.first, key + ".mu");
+        const double value = r.number(item.second, key + ".mu." + region);
+        if (!(value >= 0)) r.fail(item.second, key + ".mu." + region, "must not be negative");
+        spec.mu[region] = value;
       }
     }
     if (const auto sc = c["self"]) {
@@ -643,18 +668,24 @@ Scene scene_from_yaml(const YAML::Node& root, const std::string& path) {
     }
     if (const auto f = a["feet"]) {
       r.allow(f, key + ".feet", {"foot_a", "foot_b", "mu_active", "mu_inactive"});
-      if (!scene.ground_contact) r.fail(f, key + ".feet", "foot friction needs contact.ground");
+      if (!scene.ground_contact && !scene.lattice_floor)
+        r.fail(f, key + ".feet", "foot friction needs contact.ground (or contact.lattice_floor)");
       const double mu_active = f["mu_active"] ? r.calibrated_number(f["mu_active"], key + ".feet.mu_active") : 2.0;
       const double mu_inactive =
           f["mu_inactive"] ? r.calibrated_number(f["mu_inactive"], key + ".feet.mu_inactive") : 1e-4;
-      scene.friction = true;
+      // Ground contact: friction regions; the lattice floor only: its foot voxels.
+      scene.friction = scene.ground_contact;
       for (const auto& [foot, channel] :
            {std::pair<const char*, int>{"foot_a", kChannelFootA}, {"foot_b", kChannelFootB}}) {
         if (!f[foot]) continue;
         const TimeFunction mu = timing == "voxel"
                                     ? voxel_foot_friction(*schedule, channel, start, mu_active, mu_inactive, voxel)
                                     : foot_friction(*schedule, channel, start, mu_active, mu_inactive);
-        scene.friction_spec.regions.push_back({r.text(f[foot], key + ".feet." + foot), mu, mu});
+        const std::string surface = r.text(f[foot], key + ".feet." + foot);
+        if (scene.ground_contact)
+          scene.friction_spec.regions.push_back({surface, mu, mu});
+        else
+          scene.lattice_floor_spec.feet.push_back({surface, mu});
       }
     }
   }

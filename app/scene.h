@@ -68,6 +68,11 @@
 //           # under the pairs' surfaces, inflation 20 dhat);
 //           # start [s]: the barrier acts only from then on (default: from the start)
 //           # project_hessian: true (default) projects each pair's barrier Hessian to PSD
+//     lattice_floor: {point: [0, 0, -0.004], normal: [0, 0, 1], dhat: 5e-4, kappa: 6e5, eps_v: 1e-3,
+//                     voxel_size: 0.01, mu: {skin: 2.0, bladder_1: 0.6667, ...}}
+//           # a diagnostic, robot_voxel only: the voxel lattice's floor contact (Voxelyze), a
+//           # sphere of radius L (s_x + s_y + s_z)/6 at each lattice voxel's mass centre,
+//           # growing with its bladder (contact/lattice_floor.h); mu per volume region
 //   actuation:                                  # a schedule file shared with `morphfem hw play`
 //     {schedule: schedules/rolling.yaml, start: 1.0,      # gait time 0 at t = start [s]
 //      bladders: {b1: bladder_1_wall, ...},               # channel -> cavity wall surface
@@ -111,6 +116,7 @@
 #include "actuation/gas_cavity.h"
 #include "contact/friction.h"
 #include "contact/ground.h"
+#include "contact/lattice_floor.h"
 #include "contact/self_contact.h"
 #include "core/params.h"
 #include "fem/inertia.h"
@@ -137,6 +143,17 @@ struct TractionSpec {
 };
 
 // The gait measurement of a scene that plays a schedule (see `environment`).
+// contact.lattice_floor: the voxel lattice's floor contact on a robot_voxel body, a
+// sphere at each lattice voxel's centre (contact/lattice_floor.h; a diagnostic).
+struct LatticeFloorScene {
+  LatticeFloorSpec floor;            // plane, barrier, friction smoothing
+  double voxel_size = 0.01;          // the lattice's nominal voxel size L [m]
+  std::map<std::string, double> mu;  // volume region -> friction coefficient
+  // actuation.feet without contact.ground: foot surface -> its friction mu(t), for the
+  // skin voxels (both layers) over the foot's y range, as the lattice's foot voxels.
+  std::vector<std::pair<std::string, TimeFunction>> feet;
+};
+
 struct GaitSpec {
   bool enabled = false;
   double start = 0.0, end = 0.0;  // simulation times of the gait's first column and its end [s]
@@ -173,6 +190,8 @@ struct Scene {
   GroundContactSpec ground;
   bool friction = false;
   FrictionSpec friction_spec;
+  bool lattice_floor = false;  // the voxel lattice's floor contact (a diagnostic, contact/lattice_floor.h)
+  LatticeFloorScene lattice_floor_spec;
   bool self_contact = false;  // self-contact between declared surface pairs
   SelfContactSpec self_contact_spec;
   std::string schedule_file;  // the actuation schedule, if any (its loads are in cavities/friction)

@@ -15,9 +15,11 @@
 #include <stdexcept>
 
 #include "actuation/cavity.h"
+#include "actuation/voxel_growth.h"
 #include "app/plot.h"
 #include "contact/friction.h"
 #include "contact/ground.h"
+#include "contact/lattice_floor.h"
 #include "contact/self_contact.h"
 #include "core/errors.h"
 #include "core/json.h"
@@ -31,6 +33,7 @@
 #include "fem/output.h"
 #include "fem/pull_spring.h"
 #include "mesh/geometry.h"
+#include "mesh/robot.h"
 
 namespace morphfem {
 
@@ -205,6 +208,64 @@ void reopen_finished_output(const Scene& scene, MPI_Comm comm) {
   }
   bcast_string(error, comm);
   if (!error.empty()) throw InputError("--resume", error);
+}
+
+}  // namespace
+
+namespace {
+
+// The lattice voxels of a robot_voxel scene as floor-contact points: the material
+// point at each box's centre (interpolated in its region's cells), the box's
+// footprint as area, the sphere radius L (s_x + s_y + s_z)/6 with s = base scale x
+// the region's growth stretch (actuation.growth), and the region's friction
+// coefficient, or a foot's mu(t) for skin voxels over that foot's y range.
+std::vector<LatticePoint> lattice_points(const Scene& scene, const Mesh& mesh) {
+  const std::string key = scene_key(scene, "", "contact.lattice_floor");
+  if (scene.geometry.string("type", "") != "robot_voxel")
+    throw InputError(key, "needs geometry.type robot_voxel (the lattice is the voxel study's)");
+  const LatticeFloorScene& spec = scene.lattice_floor_spec;
+  for (const auto& [region, value] : spec.mu)
+    if (!mesh.has_region(region, 3)) throw InputError(key + ".mu", "the mesh has no volume region '" + region + "'");
+  const double voxel = spec.voxel_size;
+  std::map<std::string, std::function<Eigen::Vector3d(double)>> growth;
+  for (const auto& [region, stretch] : scene.growth) growth[region] = stretch;
+  std::vector<std::pair<std::pair<double, double>, TimeFunction>> foot_ranges;  // y range [m] -> mu(t)
+  for (const auto& [surface, mu] : spec.feet) {
+    require_surface(scene, mesh, surface, "", "actuation.feet");
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    for (int a : mesh.nodes_of_surface(surface)) {
+      lo = std::min(lo, mesh.X(a, 1));
+      hi = std::max(hi, mesh.X(a, 1));
+    }
+    foot_ranges.push_back({{lo, hi}, mu});
+  }
+  std::map<std::string, std::vector<int>> region_cells;
+  std::vector<LatticePoint> points;
+  for (const LatticeVoxelBox& box : robot_voxel_lattice(scene.geometry, voxel, VoxelActuation{}.min_scale)) {
+    const auto mu = spec.mu.find(box.region);
+    if (mu == spec.mu.end())
+      throw InputError(key + ".mu", "no friction coefficient for volume region '" + box.region + "'");
+    auto cells = region_cells.find(box.region);
+    if (cells == region_cells.end()) cells = region_cells.emplace(box.region, mesh.cells_of(box.region)).first;
+    LatticePoint p;
+    p.owner_cell = interpolation_weights(mesh, cells->second, 0.5 * (box.lo + box.hi), p.nodes, p.weights);
+    p.area = (box.hi.x() - box.lo.x()) * (box.hi.y() - box.lo.y());
+    p.mu = TimeFunction::constant(mu->second);
+    const double y = 0.5 * (box.lo.y() + box.hi.y());
+    if (box.region == "skin")
+      for (const auto& [range, foot_mu] : foot_ranges)
+        if (y >= range.first && y <= range.second) p.mu = foot_mu;
+    const auto g = growth.find(box.region);
+    const Eigen::Vector3d base = box.base_scale;
+    if (g == growth.end())
+      p.radius = [r = voxel * base.sum() / 6.0](double) { return r; };
+    else
+      p.radius = [voxel, base, stretch = g->second](double t) {
+        return voxel * base.cwiseProduct(stretch(t)).sum() / 6.0;
+      };
+    points.push_back(std::move(p));
+  }
+  return points;
 }
 
 }  // namespace
@@ -404,6 +465,13 @@ SimulationResult run_scene(const Scene& scene, MPI_Comm comm, const RunOptions& 
     spec.young_modulus = 3.0 * contact_shear_modulus(mesh, materials, surfaces);  // as for the ground
     self_contact = std::make_shared<SelfContactTerm>(mesh, partition, rank, spec);
     assembler.add_term(self_contact);
+  }
+  // The voxel lattice's floor contact (a diagnostic): a sphere per lattice voxel.
+  std::shared_ptr<LatticeFloorTerm> lattice_floor;
+  if (scene.lattice_floor) {
+    lattice_floor = std::make_shared<LatticeFloorTerm>(mesh, partition, rank, scene.lattice_floor_spec.floor,
+                                                       lattice_points(scene, mesh));
+    assembler.add_term(lattice_floor);
   }
   std::vector<DirichletCondition> bcs;
   const double t_end = scene.solver.t_end;

@@ -11,6 +11,7 @@
 #include <gmsh.h>
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <map>
 #include <stdexcept>
@@ -350,6 +351,43 @@ Mesh build_robot_voxel(const ParamSet& params) {
     a.pieces.push_back({axis_box(x0, x1, y0, y1, z0, z0 + hb), bladder_name(k)});
   }
   return mesh_assembly(a, c.mesh_size, c.order, params, "robot_voxel");
+}
+
+std::vector<LatticeVoxelBox> robot_voxel_lattice(const ParamSet& params, double voxel, double bladder_min_scale) {
+  if (!(voxel > 0) || !(bladder_min_scale > 0))
+    throw InputError(params.where("type"), "the lattice needs a voxel size > 0 and a bladder scale > 0");
+  const CommonRobot c = common_robot(params, 0.15, 0.22, 0.002, 0.01, 0.01, 0.02, 0.03, 0.03);
+  const double t = length_param(params, "layer_thickness", 0.01);
+  const double y0 = params.number_in("bladder_start", 0.0, c.length, 0.03);
+  const double y1 = params.number_in("bladder_end", 0.0, c.length, 0.19);
+  const double hb = c.bladder_thickness;
+  const double z_core = hb + t, z_top = z_core + c.core_gap, z_upper = z_top + t;
+  // n boxes of equal size over [a, b]: the voxel count, at least one.
+  const auto bins = [](double a, double b, double size) {
+    const int n = std::max(1, static_cast<int>(std::lround((b - a) / size)));
+    std::vector<double> edges(n + 1);
+    for (int i = 0; i <= n; ++i) edges[i] = a + (b - a) * i / n;
+    return edges;
+  };
+  std::vector<LatticeVoxelBox> boxes;
+  const auto add_block = [&](const std::string& region, double xa, double xb, double ya, double yb, double za,
+                             double zb, double z_size) {
+    const auto ex = bins(xa, xb, voxel), ey = bins(ya, yb, voxel), ez = bins(za, zb, z_size);
+    for (size_t k = 0; k + 1 < ez.size(); ++k)
+      for (size_t j = 0; j + 1 < ey.size(); ++j)
+        for (size_t i = 0; i + 1 < ex.size(); ++i)
+          boxes.push_back({region, Eigen::Vector3d(ex[i], ey[j], ez[k]),
+                           Eigen::Vector3d(ex[i + 1], ey[j + 1], ez[k + 1]),
+                           Eigen::Vector3d(1.0, 1.0, (ez[k + 1] - ez[k]) / voxel)});
+  };
+  add_block("skin", 0, c.width, 0, c.length, hb, z_core, voxel);
+  add_block("skin", 0, c.width, 0, c.length, z_top, z_upper, voxel);
+  for (int k = 1; k <= kBladders; ++k) {
+    const auto [x0, x1] = column_x(bladder_column(k), c.width, c.bladder_width);
+    const double z0 = k <= 4 ? z_upper : 0.0;
+    add_block(bladder_name(k), x0, x1, y0, y1, z0, z0 + hb, bladder_min_scale * voxel);
+  }
+  return boxes;
 }
 
 Mesh build_robot_physical(const ParamSet& params) {

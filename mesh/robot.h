@@ -61,6 +61,10 @@
 //   Surfaces: core_wall, bladder_1_wall .. bladder_8_wall (closed chamber cavities),
 //   bottom, foot_a, foot_b, outer (as for robot_voxel), fabric_sheet (membrane fabric).
 #pragma once
+#include <Eigen/Dense>
+#include <string>
+#include <vector>
+
 #include "core/params.h"
 #include "mesh/mesh.h"
 
@@ -68,5 +72,20 @@ namespace morphfem {
 
 Mesh build_robot_voxel(const ParamSet& params);
 Mesh build_robot_physical(const ParamSet& params);
+
+// The voxel study's lattice over a robot_voxel body of these parameters: one box of
+// reference space per lattice voxel (ROBOT.md), for the lattice's floor contact
+// (contact/lattice_floor.h). Skin layers are split into voxel x voxel columns (one
+// voxel through a layer), each bladder block into voxel-wide columns and
+// round(bladder_thickness / (bladder_min_scale voxel)) voxels through its
+// thickness (the lattice's deflated bladder voxels, 0.2 voxel thick: two). Along y a
+// body shorter than a voxel (a slice) is one voxel. The bonding strips in the core
+// gap belong to no box (the lattice's layers touch there). base_scale is the box's
+// lattice scale when nothing grows: (1, 1, box thickness / voxel).
+struct LatticeVoxelBox {
+  std::string region;  // volume region of the box's cells
+  Eigen::Vector3d lo, hi, base_scale;
+};
+std::vector<LatticeVoxelBox> robot_voxel_lattice(const ParamSet& params, double voxel, double bladder_min_scale);
 
 }  // namespace morphfem

@@ -499,3 +499,49 @@ TEST(Scene, ContactStiffnessFollowsTheMaterialUnderTheSurface) {
   EXPECT_EQ(contact_shear_modulus(mesh, materials, {"bottom", "outer"}), 4.3e4);
   EXPECT_EQ(contact_shear_modulus(mesh, materials, {"bladder_1_wall"}), 1.5e5);  // the chamber's own DS30
 }
+
+// contact.lattice_floor (a diagnostic, contact/lattice_floor.h): bad keys are named,
+// and the voxel preset's slice falls onto the lattice's spheres and rests on them,
+// its lowest face held up by the protrusion of the deflated bladder voxels' spheres
+// (L (1 + 1 + 0.2)/6 - 1 mm = 2.67 mm beyond the face): no face touches the floor.
+TEST(Scene, LatticeFloorHoldsTheVoxelSliceOnItsSpheres) {
+  std::string e = error_of(std::string(kGood) + "contact: {lattice_floor: {mu: {body: 1}}}\n");
+  EXPECT_NE(e.find("contact.lattice_floor"), std::string::npos) << e;
+  EXPECT_NE(e.find("kappa"), std::string::npos) << e;
+  e = error_of(std::string(kGood) + "contact: {lattice_floor: {kappa: 1.0e6, mu: {body: 1}}}\n");
+  EXPECT_NE(e.find("robot_voxel"), std::string::npos) << e;
+  e = error_of(std::string(kGood) + "contact: {lattice_floor: {kappa: 1.0e6, mu: [1]}}\n");
+  EXPECT_NE(e.find("contact.lattice_floor.mu"), std::string::npos) << e;
+
+  std::ifstream in(std::string(MORPHFEM_SOURCE_DIR) + "/examples/voxel/roll_slice.yaml");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const auto from = text.find("\ncontact:"), to = text.find("\ndynamics:");
+  ASSERT_NE(from, std::string::npos);
+  ASSERT_NE(to, std::string::npos);
+  const double floor_z = -0.003;
+  const std::string mu =
+      "mu: {skin: 2.0, bladder_1: 0.6667, bladder_2: 0.6667, bladder_3: 0.6667, bladder_4: 0.6667, "
+      "bladder_5: 0.6667, bladder_6: 0.6667, bladder_7: 0.6667";
+  const std::string contact =
+      "\ncontact:\n  lattice_floor: {point: [0, 0, -0.003], dhat: 5.0e-4, kappa: 6.0e5, " + mu + "}}";
+  text.replace(from, to - from, contact);
+  text = replace(text, "end_time: 21.3", "end_time: 0.3");
+  text =
+      replace(text, "../schedules/rolling.yaml", std::string(MORPHFEM_SOURCE_DIR) + "/examples/schedules/rolling.yaml");
+  text = replace(text, "output: {directory: results/voxel/roll_slice, every: 2}", "output: {directory: OUT}");
+  e = error_of(text);  // bladder_8 has no coefficient
+  EXPECT_NE(e.find("no friction coefficient for volume region 'bladder_8'"), std::string::npos) << e;
+  text = replace(text, "bladder_7: 0.6667}", "bladder_7: 0.6667, bladder_8: 0.6667}");
+  TempScene s(text);
+  Scene scene = read_scene(s.file.string());
+  ASSERT_TRUE(scene.lattice_floor);
+  const SimulationResult r = run_scene(scene, PETSC_COMM_WORLD, {false, false});
+  ASSERT_TRUE(r.stats.completed);
+  double lowest = 1e300;
+  for (int a = 0; a < r.mesh.n_nodes(); ++a) lowest = std::min(lowest, r.mesh.X(a, 2) + r.u(a, 2));
+  // Resting on faces would leave less than dhat (0.5 mm); falling freely, 0.44 m
+  // below the start after 0.3 s; the spheres hold the faces 1.9 mm up (their 2.7 mm
+  // protrusion less the barrier gap and the soft bladders' indentation).
+  EXPECT_GT(lowest - floor_z, 0.0012);
+  EXPECT_LT(lowest - floor_z, 0.0031);
+}

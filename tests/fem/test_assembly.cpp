@@ -7,6 +7,7 @@
 
 #include "fem/assembly.h"
 #include "tests/support/block_mesh.h"
+#include "tests/support/petsc_environment.h"
 
 using namespace morphfem;
 using morphfem::testing::block_mesh;
@@ -14,19 +15,7 @@ using morphfem::testing::one_rank;
 
 namespace {
 
-// The other fem tests need no PETSc; these do (MPI, Vec, Mat).
-class PetscEnvironment : public ::testing::Environment {
- public:
-  void SetUp() override {
-    PetscBool up = PETSC_FALSE;
-    PetscInitialized(&up);
-    if (!up) {
-      ASSERT_EQ(PetscInitializeNoArguments(), 0);
-    }
-  }
-  void TearDown() override { PetscFinalize(); }
-};
-const auto* const petsc_environment = ::testing::AddGlobalTestEnvironment(new PetscEnvironment);
+// The other fem tests need no PETSc; these do (MPI, Vec, Mat): tests/support/petsc_environment.h.
 
 // Pairs of nodes joined by one-sided springs (compression only, like a barrier:
 // E = k/2 (L0 - l)^2 for l < L0, else 0) and triples joined by a three-node term
