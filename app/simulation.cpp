@@ -212,8 +212,6 @@ void reopen_finished_output(const Scene& scene, MPI_Comm comm) {
 
 }  // namespace
 
-namespace {
-
 // The lattice voxels of a robot_voxel scene as floor-contact points: the material
 // point at each box's centre (interpolated in its region's cells), the box's
 // footprint as area, the sphere radius L (s_x + s_y + s_z)/6 with s = base scale x
@@ -267,8 +265,6 @@ std::vector<LatticePoint> lattice_points(const Scene& scene, const Mesh& mesh) {
   }
   return points;
 }
-
-}  // namespace
 
 std::string scene_identity(const YAML::Node& doc) {
   YAML::Node copy = YAML::Clone(doc);

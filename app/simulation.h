@@ -76,6 +76,14 @@ double contact_shear_modulus(const Mesh& mesh, const std::vector<std::shared_ptr
 // directory is created.
 Mesh build_scene_mesh(const Scene& scene, MPI_Comm comm);
 
+// The lattice voxels of a robot_voxel scene with contact.lattice_floor as floor
+// contact points (contact/lattice_floor.h): the material point at each voxel box's
+// centre, its footprint, its sphere radius L (s_x + s_y + s_z)/6 growing with the
+// region's actuation.growth, and its friction coefficient: the region's, or for skin
+// voxels over a foot's y range (both layers, as the lattice's foot voxels) the
+// foot's mu(t) from actuation.feet. Throws InputError naming the scene key.
+std::vector<LatticePoint> lattice_points(const Scene& scene, const Mesh& mesh);
+
 // Runs the scene. A solve that fails after all step cuts returns with
 // stats.completed == false and stats.failure set; the last converged state is
 // in `u` and in the output (written with status "failed").

@@ -545,3 +545,58 @@ TEST(Scene, LatticeFloorHoldsTheVoxelSliceOnItsSpheres) {
   EXPECT_GT(lowest - floor_z, 0.0012);
   EXPECT_LT(lowest - floor_z, 0.0031);
 }
+
+// The 3D voxel preset's lattice points: the study's 1428 voxels; skin voxels over a
+// foot's y range (both layers) take the foot's friction over time (active before the
+// gait, inactive in the rolling gait's actuation phases), other skin voxels the skin's,
+// bladder voxels theirs; a deflated bladder voxel's sphere has radius L 2.2/6, a skin
+// voxel's L/2, and an inflated one's L (s_x + s_y + 2.5)/6.
+TEST(Scene, LatticePointsOfTheVoxelPresetCarryFeetAndGrowingRadii) {
+  std::ifstream in(std::string(MORPHFEM_SOURCE_DIR) + "/examples/voxel/roll_flat.yaml");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const auto from = text.find("\ncontact:"), to = text.find("\ndynamics:");
+  ASSERT_NE(from, std::string::npos);
+  text.replace(from, to - from,
+               "\ncontact:\n  lattice_floor: {point: [0, 0, -0.003], kappa: 6.0e5, mu: {skin: 2.0, bladder_1: 0.5, "
+               "bladder_2: 0.5, bladder_3: 0.5, bladder_4: 0.5, bladder_5: 0.5, bladder_6: 0.5, bladder_7: 0.5, "
+               "bladder_8: 0.5}}");
+  text =
+      replace(text, "../schedules/rolling.yaml", std::string(MORPHFEM_SOURCE_DIR) + "/examples/schedules/rolling.yaml");
+  text = replace(text, "mesh_size: 0.015", "mesh_size: 0.02");
+  TempScene s(text);
+  const Scene scene = read_scene(s.file.string());
+  ASSERT_TRUE(scene.lattice_floor);
+  ASSERT_FALSE(scene.friction);  // the feet went to the lattice floor
+  ASSERT_EQ(scene.lattice_floor_spec.feet.size(), 2u);
+  const Mesh mesh = build_scene_mesh(scene, PETSC_COMM_WORLD);
+  const std::vector<LatticePoint> points = lattice_points(scene, mesh);
+  ASSERT_EQ(points.size(), 1428u);
+  const double t_gait = 1.5 + 0.1;  // in column 1's actuation phase (rolling: feet inactive)
+  const double t_inflated = 30.0;   // after the gait: every bladder deflated again, feet active
+  int feet = 0, skin = 0, bladders = 0, grown = 0;
+  for (const LatticePoint& p : points) {
+    Eigen::Vector3d X = Eigen::Vector3d::Zero();
+    for (size_t a = 0; a < p.nodes.size(); ++a) X += p.weights[a] * mesh.X.row(p.nodes[a]).transpose();
+    const double r0 = p.radius(0.0);
+    if (std::abs(r0 - 0.005) < 1e-12) {  // skin
+      if (X.y() < 0.03 || X.y() > 0.19) {
+        ++feet;
+        EXPECT_EQ(p.mu(0.0), 2.0);
+        EXPECT_NEAR(p.mu(t_gait), 1e-4, 1e-12);
+        EXPECT_EQ(p.mu(t_inflated), 2.0);
+      } else {
+        ++skin;
+        EXPECT_EQ(p.mu(t_gait), 2.0);
+      }
+    } else {
+      ++bladders;
+      EXPECT_NEAR(r0, 0.01 * 2.2 / 6.0, 1e-12);
+      EXPECT_EQ(p.mu(t_gait), 0.5);
+      if (p.radius(1.5 + 0.9) > 0.0075) ++grown;  // bladder 8 inflates in column 1 (0.81 s swing)
+    }
+  }
+  EXPECT_EQ(feet, 2 * 2 * 15 * 3);  // two feet, both layers, 15 x 3 voxels each
+  EXPECT_EQ(skin, 660 - feet);
+  EXPECT_EQ(bladders, 768);
+  EXPECT_EQ(grown, 3 * 16 * 2);  // bladder 8's voxels
+}
