@@ -297,7 +297,9 @@ SimulationResult run_robot_case(const RobotCase& c, const RobotFidelity& level, 
   const YAML::Node doc = robot_scene_yaml(c, level, output_dir);
   // Messages name the template; relative paths in it stay relative to it.
   Scene scene = scene_from_yaml(doc, c.template_scene);
-  SimulationResult r = run_scene(scene, comm, RunOptions{!output_dir.empty(), progress});
+  RunOptions options{!output_dir.empty(), progress};
+  options.scene_text = scene_identity(doc);  // so that `morphfem run DIR/scene.yaml --resume` can extend it
+  SimulationResult r = run_scene(scene, comm, options);
   int rank = 0;
   MPI_Comm_rank(comm, &rank);
   if (rank == 0 && !r.output_dir.empty()) {

@@ -2,13 +2,16 @@
 // cases of the voxel study, inline schedules, and one cheap run that must not drift.
 #include <gtest/gtest.h>
 #include <petscsys.h>
+#include <unistd.h>
 
 #include <cmath>
+#include <filesystem>
 #include <map>
 
 #include "actuation/voxel_growth.h"
 #include "app/robot_study.h"
 #include "app/scene.h"
+#include "app/simulation.h"
 #include "core/errors.h"
 
 using namespace morphfem;
@@ -202,4 +205,28 @@ TEST(RobotStudy, EmptyScheduleOnFlatGroundStaysPut) {
   ASSERT_TRUE(r.gait_complete);
   EXPECT_LT(std::abs(r.speed_bl_per_s), 0.005);
   EXPECT_GT(r.min_J, 0.0);
+}
+
+// A case's saved scene.yaml extends its run: `morphfem run DIR/scene.yaml --resume
+// --set solver.end_time=LATER` finds the checkpoint's scene identical (the case run
+// records its scene like `morphfem run` does).
+TEST(RobotStudy, SavedCaseSceneResumesItsRun) {
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("morphfem_case_resume_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  RobotCase c = baseline("empty_0deg_0kPa_flat");
+  c.overrides = {"solver.end_time=0.1"};
+  const SimulationResult first = run_robot_case(c, find_robot_fidelity("0"), dir.string(), PETSC_COMM_WORLD, false);
+  ASSERT_TRUE(first.stats.completed) << first.stats.failure;
+  const std::string saved = first.output_dir + "/scene.yaml";
+  YAML::Node doc = load_scene_yaml(saved);
+  set_scene_key(doc, "solver.end_time=0.2", saved);
+  const Scene scene = scene_from_yaml(doc, saved);
+  RunOptions options{true, false};
+  options.resume = true;
+  options.scene_text = scene_identity(doc);
+  const SimulationResult extended = run_scene(scene, PETSC_COMM_WORLD, options);
+  EXPECT_TRUE(extended.stats.completed) << extended.stats.failure;
+  EXPECT_NEAR(extended.resumed_at, 0.1, 1e-9);
+  std::filesystem::remove_all(dir);
 }
