@@ -14,6 +14,7 @@
 #include "tests/support/block_mesh.h"
 #include "tests/support/finite_differences.h"
 #include "tests/support/petsc_environment.h"
+#include "tests/support/piece_state.h"
 
 using namespace morphfem;
 using morphfem::testing::one_rank;
@@ -45,17 +46,6 @@ LatticeFloorSpec floor_at(double z) {
   spec.kappa = 1e6;
   spec.eps_v = 1e-3;
   return spec;
-}
-
-PieceState state_of(const Mesh& mesh, const std::vector<int>& nodes, const RowMatrixXd& u) {
-  PieceState s;
-  s.X.resize(nodes.size(), 3);
-  s.u.resize(nodes.size(), 3);
-  for (size_t a = 0; a < nodes.size(); ++a) {
-    s.X.row(a) = mesh.X.row(nodes[a]);
-    s.u.row(a) = u.row(nodes[a]);
-  }
-  return s;
 }
 
 }  // namespace
@@ -129,7 +119,7 @@ TEST(LatticeFloor, GradientAndHessianMatchFiniteDifferences) {
       RowMatrixXd u = RowMatrixXd::Zero(mesh.n_nodes(), 3);
       for (int a = 0; a < mesh.n_nodes(); ++a)
         for (int i = 0; i < 3; ++i) u(a, i) = 5e-5 * unit(rng);
-      PieceState s = state_of(mesh, nodes, u);
+      PieceState s = morphfem::testing::piece_state(mesh, nodes, u);
       const Eigen::Vector3d c_rest = term.centre(0, s);
       const Eigen::Vector3d shift(slip_over_eps * eps, 0.3 * slip_over_eps * eps,
                                   -(c_rest.z() - 0.0041) + 1e-4 * unit(rng));

@@ -12,6 +12,7 @@
 #include "contact/self_contact.h"
 #include "mesh/geometry.h"
 #include "tests/support/block_mesh.h"
+#include "tests/support/piece_state.h"
 
 using namespace morphfem;
 
@@ -305,14 +306,7 @@ double term_energy(const EnergyTerm& term, const Mesh& mesh, const RowMatrixXd& 
   std::vector<int> nodes;
   for (int k = 0; k < term.n_pieces(); ++k) {
     term.piece_nodes(k, nodes);
-    PieceState s;
-    s.X.resize(nodes.size(), 3);
-    s.u.resize(nodes.size(), 3);
-    for (size_t a = 0; a < nodes.size(); ++a) {
-      s.X.row(a) = mesh.X.row(nodes[a]);
-      s.u.row(a) = u.row(nodes[a]);
-    }
-    total += term.piece(k, s, nullptr, nullptr);
+    total += term.piece(k, morphfem::testing::piece_state(mesh, nodes, u), nullptr, nullptr);
   }
   return total;
 }

@@ -10,22 +10,12 @@
 #include "mesh/geometry.h"
 #include "tests/support/block_mesh.h"
 #include "tests/support/finite_differences.h"
+#include "tests/support/piece_state.h"
 
 namespace morphfem {
 namespace {
 
 Mesh block_mesh(int order) { return testing::block_mesh({0.02, 0.01, 0.005}, 0.005, order); }
-
-PieceState piece_state(const Mesh& mesh, const std::vector<int>& nodes, const RowMatrixXd& u) {
-  PieceState s;
-  s.X.resize(nodes.size(), 3);
-  s.u.resize(nodes.size(), 3);
-  for (size_t a = 0; a < nodes.size(); ++a) {
-    s.X.row(a) = mesh.X.row(nodes[a]);
-    s.u.row(a) = u.row(nodes[a]);
-  }
-  return s;
-}
 
 TEST(PullSpring, ForceIsStiffnessTimesSpringStretch) {
   const Mesh mesh = block_mesh(1);
@@ -40,7 +30,7 @@ TEST(PullSpring, ForceIsStiffnessTimesSpringStretch) {
   std::vector<int> nodes;
   term.piece_nodes(0, nodes);
   term.set_time(3.0);
-  const PieceState s = piece_state(mesh, nodes, u);
+  const PieceState s = testing::piece_state(mesh, nodes, u);
   Eigen::VectorXd g;
   const double E = term.piece(0, s, &g, nullptr);
   EXPECT_NEAR(E, 0.5 * 200.0 * 0.003 * 0.003, 1e-14);
@@ -66,7 +56,7 @@ TEST(PullSpring, GradientAndHessianMatchFiniteDifferences) {
     for (int i = 0; i < u.size(); ++i) u.data()[i] = r(rng);
     std::vector<int> nodes;
     term.piece_nodes(0, nodes);
-    const PieceState s = piece_state(mesh, nodes, u);
+    const PieceState s = testing::piece_state(mesh, nodes, u);
     Eigen::VectorXd g, g_fd;
     Eigen::MatrixXd H, H_fd;
     const double E = term.piece(0, s, &g, &H);
