@@ -463,12 +463,9 @@ SimulationResult run_scene(const Scene& scene, MPI_Comm comm, const RunOptions& 
     assembler.add_term(self_contact);
   }
   // The voxel lattice's floor contact (a diagnostic): a sphere per lattice voxel.
-  std::shared_ptr<LatticeFloorTerm> lattice_floor;
-  if (scene.lattice_floor) {
-    lattice_floor = std::make_shared<LatticeFloorTerm>(mesh, partition, rank, scene.lattice_floor_spec.floor,
-                                                       lattice_points(scene, mesh));
-    assembler.add_term(lattice_floor);
-  }
+  if (scene.lattice_floor)
+    assembler.add_term(std::make_shared<LatticeFloorTerm>(mesh, partition, rank, scene.lattice_floor_spec.floor,
+                                                          lattice_points(scene, mesh)));
   std::vector<DirichletCondition> bcs;
   const double t_end = scene.solver.t_end;
   for (const auto& b : scene.boundary) {

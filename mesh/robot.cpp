@@ -324,21 +324,44 @@ std::vector<std::string> volume_order(bool with_fabric) {
 
 }  // namespace
 
-Mesh build_robot_voxel(const ParamSet& params) {
+namespace {
+
+// The robot_voxel body's parameters and its stacking in z (read once, for the mesh
+// and for its lattice): bladders [0, hb], bottom layer [hb, z_core], core gap,
+// top layer [z_top, z_upper], bladders [z_upper, z_upper + hb]; bladders over y in
+// [y0, y1].
+struct VoxelLayout {
+  CommonRobot c;
+  double t = 0, y0 = 0, y1 = 0, hb = 0, z_core = 0, z_top = 0, z_upper = 0;
+};
+
+VoxelLayout voxel_layout(const ParamSet& params) {
   params.allow_only({"type", "mesh_size", "order", "width", "length", "layer_thickness", "core_gap", "edge_width",
                      "end_seal", "bladder_thickness", "bladder_width", "bladder_start", "bladder_end", "foot_length"});
-  const CommonRobot c = common_robot(params, 0.15, 0.22, 0.002, 0.01, 0.01, 0.02, 0.03, 0.03);
-  const double t = length_param(params, "layer_thickness", 0.01);
-  const double y0 = params.number_in("bladder_start", 0.0, c.length, 0.03);
-  const double y1 = params.number_in("bladder_end", 0.0, c.length, 0.19);
-  require(y0 < y1, params, "bladder_end", "bladder_end must exceed bladder_start");
+  VoxelLayout l;
+  l.c = common_robot(params, 0.15, 0.22, 0.002, 0.01, 0.01, 0.02, 0.03, 0.03);
+  l.t = length_param(params, "layer_thickness", 0.01);
+  l.y0 = params.number_in("bladder_start", 0.0, l.c.length, 0.03);
+  l.y1 = params.number_in("bladder_end", 0.0, l.c.length, 0.19);
+  require(l.y0 < l.y1, params, "bladder_end", "bladder_end must exceed bladder_start");
+  l.hb = l.c.bladder_thickness;
+  l.z_core = l.hb + l.t;
+  l.z_top = l.z_core + l.c.core_gap;
+  l.z_upper = l.z_top + l.t;
+  return l;
+}
+
+}  // namespace
+
+Mesh build_robot_voxel(const ParamSet& params) {
+  const VoxelLayout l = voxel_layout(params);
+  const CommonRobot& c = l.c;
+  const double t = l.t, y0 = l.y0, y1 = l.y1, hb = l.hb, z_core = l.z_core, z_top = l.z_top, z_upper = l.z_upper;
 
   Assembly a;
   a.length = c.length;
   a.foot_length = c.foot_length;
   a.volume_order = volume_order(false);
-  const double hb = c.bladder_thickness;
-  const double z_core = hb + t, z_top = z_core + c.core_gap, z_upper = z_top + t;
   a.foot_z = hb;
   a.foot_top_z = hb + t;  // the feet are the bottom layer's foot voxels (ROBOT.md)
   a.scale = std::max({c.width, c.length, z_upper + hb});
@@ -356,12 +379,9 @@ Mesh build_robot_voxel(const ParamSet& params) {
 std::vector<LatticeVoxelBox> robot_voxel_lattice(const ParamSet& params, double voxel, double bladder_min_scale) {
   if (!(voxel > 0) || !(bladder_min_scale > 0))
     throw InputError(params.where("type"), "the lattice needs a voxel size > 0 and a bladder scale > 0");
-  const CommonRobot c = common_robot(params, 0.15, 0.22, 0.002, 0.01, 0.01, 0.02, 0.03, 0.03);
-  const double t = length_param(params, "layer_thickness", 0.01);
-  const double y0 = params.number_in("bladder_start", 0.0, c.length, 0.03);
-  const double y1 = params.number_in("bladder_end", 0.0, c.length, 0.19);
-  const double hb = c.bladder_thickness;
-  const double z_core = hb + t, z_top = z_core + c.core_gap, z_upper = z_top + t;
+  const VoxelLayout l = voxel_layout(params);
+  const CommonRobot& c = l.c;
+  const double y0 = l.y0, y1 = l.y1, hb = l.hb, z_core = l.z_core, z_top = l.z_top, z_upper = l.z_upper;
   // n boxes of equal size over [a, b]: the voxel count, at least one.
   const auto bins = [](double a, double b, double size) {
     const int n = std::max(1, static_cast<int>(std::lround((b - a) / size)));
