@@ -137,26 +137,37 @@ bool FrictionTerm::update_after_solve(Assembler& assembler, Vec u1) {
 
 // D = lambda F(y), y = |r|, r = P (u - u0):
 // grad = lambda phi/y r,  Hess = lambda [phi/y P + (phi' - phi/y) rhat rhat^T].
+double lagged_friction(const FrictionLaw& law, double lambda, const Eigen::Matrix3d& tangent_projector,
+                       const Eigen::Vector3d& dx, bool clamp_drop, Eigen::Vector3d* grad, Eigen::Matrix3d* hess) {
+  const Eigen::Vector3d r = tangent_projector * dx;
+  const double y = r.norm();
+  const double phi_over_y = law.force_over_y(y);
+  if (grad) *grad = lambda * phi_over_y * r;
+  if (hess) {
+    *hess = lambda * phi_over_y * tangent_projector;
+    if (y > 0) {
+      double dphi = law.dforce(y);
+      if (clamp_drop) dphi = std::max(dphi, 0.0);
+      const Eigen::Vector3d rhat = r / y;
+      *hess += lambda * (dphi - phi_over_y) * rhat * rhat.transpose();
+    }
+  }
+  return lambda * law.potential(y);
+}
+
 double FrictionTerm::piece(int k, const PieceState& s, Eigen::VectorXd* g, Eigen::MatrixXd* H) const {
   if (g) g->setZero(3);
   if (H) H->setZero(3, 3);
   const double lambda = lambda_[k];
   if (!(lambda > 0)) return 0.0;
-  const FrictionLaw f = law(k);
-  const Eigen::Vector3d r = tangent_projector_ * (s.u.row(0).transpose() - u0_[k]);
-  const double y = r.norm();
-  const double phi_over_y = f.force_over_y(y);
-  if (g) *g = lambda * phi_over_y * r;
-  if (H) {
-    *H = lambda * phi_over_y * tangent_projector_;
-    if (y > 0) {
-      double dphi = f.dforce(y);
-      if (spec_.project_hessian && !exact_hessian_) dphi = std::max(dphi, 0.0);
-      const Eigen::Vector3d rhat = r / y;
-      *H += lambda * (dphi - phi_over_y) * rhat * rhat.transpose();
-    }
-  }
-  return lambda * f.potential(y);
+  Eigen::Vector3d grad;
+  Eigen::Matrix3d hess;
+  const double energy =
+      lagged_friction(law(k), lambda, tangent_projector_, s.u.row(0).transpose() - u0_[k],
+                      spec_.project_hessian && !exact_hessian_, g ? &grad : nullptr, H ? &hess : nullptr);
+  if (g) *g = grad;
+  if (H) *H = hess;
+  return energy;
 }
 
 FrictionTerm::NodalFriction FrictionTerm::nodal_friction(Assembler& assembler, Vec u) const {

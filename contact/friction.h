@@ -75,6 +75,16 @@ struct FrictionLaw {
   double dforce(double y) const;        // phi'(y)
 };
 
+// The lagged friction potential of one contact point, the kernel every friction
+// term calls: with normal force lambda [N] and tangential slip r = P dx over the
+// step (P = I - n n^T, dx the point's motion since the step's start [m]),
+//   D = lambda F(|r|) [J],  dD/dx = lambda phi(y)/y r [N],
+//   d2D/dx2 = lambda [ phi(y)/y P + (phi'(y) - phi(y)/y) rhat rhat^T ] [N/m],
+// phi' clamped to >= 0 when clamp_drop (the PSD projection of the static->kinetic
+// drop). Returns D; grad and hess (may be null) are overwritten.
+double lagged_friction(const FrictionLaw& law, double lambda, const Eigen::Matrix3d& tangent_projector,
+                       const Eigen::Vector3d& dx, bool clamp_drop, Eigen::Vector3d* grad, Eigen::Matrix3d* hess);
+
 class FrictionTerm : public EnergyTerm {
  public:
   // Pieces: the owned contact nodes of `ground` that lie on a friction region.

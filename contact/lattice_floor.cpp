@@ -155,19 +155,12 @@ double LatticeFloorTerm::piece(int k, const PieceState& s, Eigen::VectorXd* g, E
   }
   const double lambda = lambda_[k];
   if (lambda > 0) {
-    const FrictionLaw law{mu_[k], mu_[k], spec_.eps_v * h_};
-    const Eigen::Vector3d r = tangent_projector_ * (c - c0_[k]);
-    const double y = r.norm();
-    const double phi_over_y = law.force_over_y(y);
-    energy += lambda * law.potential(y);
-    force += lambda * phi_over_y * r;
-    stiffness += lambda * phi_over_y * tangent_projector_;
-    if (y > 0) {
-      double dphi = law.dforce(y);
-      if (spec_.project_hessian && !exact_hessian_) dphi = std::max(dphi, 0.0);
-      const Eigen::Vector3d rhat = r / y;
-      stiffness += lambda * (dphi - phi_over_y) * rhat * rhat.transpose();
-    }
+    Eigen::Vector3d friction_force;
+    Eigen::Matrix3d friction_stiffness;
+    energy += lagged_friction(FrictionLaw{mu_[k], mu_[k], spec_.eps_v * h_}, lambda, tangent_projector_, c - c0_[k],
+                              spec_.project_hessian && !exact_hessian_, &friction_force, &friction_stiffness);
+    force += friction_force;
+    stiffness += friction_stiffness;
   }
   for (int a = 0; a < n; ++a) {
     if (g) g->segment<3>(3 * a) = p.weights[a] * force;
