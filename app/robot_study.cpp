@@ -32,7 +32,7 @@ std::string source_dir() { return MORPHFEM_SOURCE_DIR; }
 
 const char* kRobotUsage =
     "usage: morphfem robot COMMAND [options]\n"
-    "  validate [--fidelity L] [--cases A,B,...] [--presets voxel,physical] [--out DIR]\n"
+    "  validate [--fidelity L] [--cases A,B,...] [--presets voxel,lattice-mechanics,physical] [--out DIR]\n"
     "           [--set KEY=VALUE ...] [--set-physical KEY=VALUE ...] [--set-physical-round KEY=VALUE ...]\n"
     "           [--set-physical-flat KEY=VALUE ...]\n"
     "        the voxel study's baselines (hand-designed rolling and inching, flat and\n"
@@ -40,7 +40,9 @@ const char* kRobotUsage =
     "        speed (voxel-study preset, growth actuation; --set keys, level L), wall time,\n"
     "        dofs, steps, and beside the physical laminate with pressure actuation (inflated:\n"
     "        examples/physical/roll_slice.yaml, flat: examples/physical/inch_flat.yaml;\n"
-    "        --set-physical keys apply to both, --set-physical-round / -flat to one)\n"
+    "        --set-physical keys apply to both, --set-physical-round / -flat to one); preset\n"
+    "        lattice-mechanics (not by default): the voxel-study preset with the lattice's floor\n"
+    "        spheres, bladder stiffness and mass, as a further column (needs order 2)\n"
     "  ladder --case NAME [--levels 0,1,2] [--out DIR]\n"
     "        one case on several fidelity levels: speed against wall time, and the\n"
     "        cheapest level within 5 % of the finest\n"
@@ -61,7 +63,7 @@ const char* kRobotUsage =
     "        pulled at the scene's speed with its feet inflated and deflated; force against\n"
     "        crosshead travel as exports `calibrate pull-tests` reads, their coefficients, PNG\n"
     "        (foot states spread over the MPI ranks)\n"
-    "  benchmark [--fidelity L] [--presets voxel,physical]\n"
+    "  benchmark [--fidelity L] [--presets voxel,lattice-mechanics,physical]\n"
     "        wall time of each hand-designed gait (19.8 s) on one rank, beside the voxel\n"
     "        simulator's 136-145 s on this machine (physical: the templates' own meshes)\n"
     "  levels    the fidelity levels\n"
@@ -180,6 +182,26 @@ std::vector<RobotCase> physical_baseline_cases(const std::string& dir) {
     c.template_scene = dir + (inflated ? "/examples/physical/roll_slice.yaml" : "/examples/physical/inch_flat.yaml");
     c.physical = true;
     out.push_back(c);
+  }
+  return out;
+}
+
+std::vector<std::string> lattice_mechanics_overrides() {
+  std::string mu;  // friction per region as in the templates: skin 2.0, bladders 2/3
+  for (int b = 1; b <= 8; ++b) mu += ", bladder_" + std::to_string(b) + ": 0.6667";
+  return {
+      "contact={lattice_floor: {point: [0, 0, -0.003], dhat: 5.0e-4, kappa: 6.0e5, eps_v: 1.0e-3, "
+      "mu: {skin: 2.0" +
+          mu + "}}}",
+      "materials.bladder_*.mu=1388889",  // 12.5 x 111111 Pa
+      "materials.bladder_*.density=15000"};
+}
+
+std::vector<RobotCase> lattice_mechanics_cases(const std::string& dir) {
+  std::vector<RobotCase> out = voxel_baseline_cases(dir);
+  for (auto& c : out) {
+    c.overrides = lattice_mechanics_overrides();
+    c.lattice_mechanics = true;
   }
   return out;
 }
@@ -342,8 +364,11 @@ std::vector<CaseOutcome> run_robot_jobs(const std::vector<std::pair<RobotCase, R
   int done_here = 0;
   const std::vector<double> all = run_jobs_over_ranks(n, CaseOutcome::kFields, comm, [&](int j, double* row) {
     const auto& [c, level] = jobs[j];
-    const std::string dir =
-        out_dir.empty() ? "" : out_dir + "/" + c.name + (c.physical ? "_physical" : "_L" + level.name);
+    const std::string dir = out_dir.empty() ? ""
+                                            : out_dir + "/" + c.name +
+                                                  (c.physical            ? "_physical"
+                                                   : c.lattice_mechanics ? "_lattice_L" + level.name
+                                                                         : "_L" + level.name);
     const SimulationResult r = run_robot_case(c, level, dir, PETSC_COMM_SELF, false);
     const double values[CaseOutcome::kFields] = {r.speed_bl_per_s,
                                                  r.gait_displacement_m,
@@ -402,14 +427,22 @@ int validate(const std::vector<std::string>& args, MPI_Comm comm) {
                        "--set-physical-flat", "--presets"});
   const RobotFidelity& level = find_robot_fidelity(option(args, "--fidelity", "0"));
   const std::string out_dir = option(args, "--out", "results/robot/validate");
-  bool voxel = false, physical = false;
+  bool voxel = false, lattice = false, physical = false;
   for (const auto& p : split(option(args, "--presets", "voxel,physical"))) {
-    if (p != "voxel" && p != "physical")
-      throw InputError("--presets", "unknown preset '" + p + "' (known: voxel, physical)");
-    (p == "voxel" ? voxel : physical) = true;
+    if (p == "voxel")
+      voxel = true;
+    else if (p == "lattice-mechanics")
+      lattice = true;
+    else if (p == "physical")
+      physical = true;
+    else
+      throw InputError("--presets", "unknown preset '" + p + "' (known: voxel, lattice-mechanics, physical)");
   }
   auto all_cases = voxel_baseline_cases(source_dir());
   for (auto& c : all_cases) c.overrides = options(args, "--set");
+  auto lattice_cases = lattice_mechanics_cases(source_dir());
+  for (auto& c : lattice_cases)  // the lattice's mechanics, then --set
+    for (const auto& assignment : options(args, "--set")) c.overrides.push_back(assignment);
   auto physical_cases = physical_baseline_cases(source_dir());
   for (auto& c : physical_cases) {  // both templates, then the inflated (round) or the flat one
     c.overrides = options(args, "--set-physical");
@@ -423,10 +456,13 @@ int validate(const std::vector<std::string>& args, MPI_Comm comm) {
     names = split(wanted);
     for (const auto& name : names) find_case(all_cases, name);  // refuses unknown names
   }
-  // The voxel-preset jobs, then the physical ones; each row of the table pairs them by name.
+  // The voxel-preset jobs, the lattice-mechanics ones, then the physical ones; each row of
+  // the table pairs them by name.
   std::vector<std::pair<RobotCase, RobotFidelity>> jobs;
   for (const auto& name : names)
     if (voxel) jobs.emplace_back(find_case(all_cases, name), level);
+  for (const auto& name : names)
+    if (lattice) jobs.emplace_back(find_case(lattice_cases, name), level);
   for (const auto& name : names)
     for (const auto& c : physical_cases)
       if (physical && c.name == name) jobs.emplace_back(c, level);
@@ -436,16 +472,19 @@ int validate(const std::vector<std::string>& args, MPI_Comm comm) {
   if (rank != 0) return 0;
   std::string table =
       "case                       slope  orient  core_Pa   voxel_BL/s      fem_BL/s   wall_s   dofs  "
-      "steps  newton  status   phys_BL/s  phys_wall_s\n";
+      "steps  newton  status   phys_BL/s  phys_wall_s" +
+      std::string(lattice ? "  lattmech_BL/s  lattmech_wall_s" : "") + "\n";
   std::vector<Json> rows;
   char line[320];
-  auto find_job = [&](const std::string& name, bool phys) -> int {
+  auto find_job = [&](const std::string& name, bool phys, bool lattice_mechanics) -> int {
     for (size_t j = 0; j < jobs.size(); ++j)
-      if (jobs[j].first.name == name && jobs[j].first.physical == phys) return static_cast<int>(j);
+      if (jobs[j].first.name == name && jobs[j].first.physical == phys &&
+          jobs[j].first.lattice_mechanics == lattice_mechanics)
+        return static_cast<int>(j);
     return -1;
   };
   for (const auto& name : names) {
-    const int jv = find_job(name, false), jp = find_job(name, true);
+    const int jv = find_job(name, false, false), jp = find_job(name, true, false), jl = find_job(name, false, true);
     const RobotCase& c = jv >= 0 ? jobs[jv].first : find_case(all_cases, name);
     std::string fem = "          -        -      -      -       -  -     ", phys = "        n/a          -";
     if (jv >= 0) {
@@ -465,14 +504,30 @@ int validate(const std::vector<std::string>& args, MPI_Comm comm) {
       j.add("preset", "physical").add("template", jobs[jp].first.template_scene);
       rows.push_back(j);
     }
-    std::snprintf(line, sizeof line, "%-26s %5.1f  %6.1f  %7.0f  %+11.5f  %s  %s\n", c.name.c_str(), c.slope_deg,
-                  c.schedule.orientation_deg, c.schedule.core_pressure_pa, c.voxel_bl_per_s, fem.c_str(), phys.c_str());
+    std::string lattmech;
+    if (jl >= 0) {
+      const auto& o = outcomes[jl];
+      char buf[96];
+      std::snprintf(buf, sizeof buf, "  %+13.5f  %15.1f%s", o.speed, o.wall_s, o.completed > 0 ? "" : " FAILED");
+      lattmech = buf;
+      Json j = outcome_json(jobs[jl].first, level, o);
+      j.add("preset", "lattice-mechanics");
+      rows.push_back(j);
+    }
+    std::snprintf(line, sizeof line, "%-26s %5.1f  %6.1f  %7.0f  %+11.5f  %s  %s%s\n", c.name.c_str(), c.slope_deg,
+                  c.schedule.orientation_deg, c.schedule.core_pressure_pa, c.voxel_bl_per_s, fem.c_str(), phys.c_str(),
+                  lattmech.c_str());
     table += line;
   }
   table +=
       "phys: the physical laminate with pressure actuation: inflated cases on its plane-strain rolling slice\n"
       "(examples/physical/roll_slice.yaml, core at the 50 kPa line pressure), flat ones on the full-length body\n"
       "(examples/physical/inch_flat.yaml); n/a: the inflated body heading along itself has no physical scene.\n";
+  if (lattice)
+    table +=
+        "lattmech: the voxel-study preset with the lattice's own mechanics: a floor sphere per voxel, bladders\n"
+        "12.5x stiffer and with the lattice's mass (app/robot_study.h, lattice_mechanics_overrides); linear\n"
+        "tetrahedra lock in bending and do not roll with it: use order 2 (e.g. --fidelity 0.02:2:0.05).\n";
   std::printf("fidelity %s: mesh %.4g m, P%d, max step %.4g s\n%s", level.name.c_str(), level.mesh_size, level.order,
               level.max_step, table.c_str());
   std::filesystem::create_directories(out_dir);
@@ -489,8 +544,10 @@ int validate(const std::vector<std::string>& args, MPI_Comm comm) {
       .add("cases", rows);
   write_file_atomic(out_dir + "/validation.json", summary.str(true) + "\n");
   write_file_atomic(out_dir + "/validation.txt", table);
-  std::printf("results: %s/validation.json, per case %s/CASE_L%s/ (physical: CASE_physical/)\n", out_dir.c_str(),
-              out_dir.c_str(), level.name.c_str());
+  std::printf(
+      "results: %s/validation.json, per case %s/CASE_L%s/ (physical: CASE_physical/, lattice mechanics: "
+      "CASE_lattice_L%s/)\n",
+      out_dir.c_str(), out_dir.c_str(), level.name.c_str(), level.name.c_str());
   return 0;
 }
 

@@ -62,6 +62,8 @@ struct RobotCase {
   // schedule, which keeps its pressures (chambers, core line pressure) and its timing;
   // the fidelity level leaves the template's mesh and time step alone.
   bool physical = false;
+  // The voxel-study preset with the lattice's own mechanics (lattice_mechanics_overrides).
+  bool lattice_mechanics = false;
 };
 
 // Sets one key of a scene document from "a.b.c=VALUE" (VALUE in YAML; a path segment
@@ -83,6 +85,23 @@ std::vector<RobotCase> voxel_baseline_cases(const std::string& source_dir);
 //    inch_flat, inch_hill15, empty_0deg_0kPa_flat, empty_90deg_0kPa_hill15.
 // The inflated body heading 90 deg (empty_90deg_12kPa_hill15) has no physical scene.
 std::vector<RobotCase> physical_baseline_cases(const std::string& source_dir);
+
+// The voxel-study preset with the lattice's own mechanics, as scene keys set after
+// the case's (preset "lattice-mechanics" of `robot validate`; README "With the
+// lattice's floor contact and stiff bladders"):
+//   contact.lattice_floor   each of the lattice's 1,428 voxels touches the floor as a
+//                           sphere (Voxelyze's floor contact) instead of the faces,
+//                           skin mu 2.0, bladders 2/3, feet from the schedule;
+//   bladder mu x 12.5       a grown lattice voxel keeps its nominal link stiffness,
+//                           5-10x stiffer than a grown continuum block (the slice
+//                           rolls from 7.5x on, 12.5x is the middle of the plateau);
+//   bladder density 15000   the lattice's bladder mass: 2 cm of voxels at 3000 kg/m^3
+//                           in the preset's 4 mm blocks [kg/m^3].
+// The floor sits 3 mm below the body so that no deflated voxel's sphere starts in it.
+// Linear tetrahedra lock in bending and do not roll with it: use order 2.
+std::vector<std::string> lattice_mechanics_overrides();
+// voxel_baseline_cases with those keys (lattice_mechanics = true).
+std::vector<RobotCase> lattice_mechanics_cases(const std::string& source_dir);
 
 // The schedule of a case as the lattice plays it: the voxel study's column length,
 // two repeats.

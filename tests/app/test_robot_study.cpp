@@ -174,6 +174,35 @@ TEST(RobotStudy, OverridesSetSceneKeysLast) {
   EXPECT_EQ(root["a"]["c"][1].as<int>(), 2);
 }
 
+// The lattice-mechanics preset: every baseline case, inflated or flat, reads with the
+// lattice's floor spheres in place of face contact (the feet go to the spheres), the
+// bladders 12.5x stiffer with the lattice's mass, and the skin unchanged; --set keys
+// still come last. An unknown preset is refused with the known ones named.
+TEST(RobotStudy, LatticeMechanicsCasesPutTheBodyOnTheLatticesSpheres) {
+  const auto cases = lattice_mechanics_cases(MORPHFEM_SOURCE_DIR);
+  ASSERT_EQ(cases.size(), voxel_baseline_cases(MORPHFEM_SOURCE_DIR).size());
+  for (RobotCase c : cases) {
+    EXPECT_TRUE(c.lattice_mechanics);
+    c.overrides.push_back("materials.skin.density=2900");
+    const YAML::Node doc = robot_scene_yaml(c, find_robot_fidelity("0.02:2:0.05"), "");
+    const Scene scene = scene_from_yaml(doc, c.template_scene);
+    EXPECT_TRUE(scene.lattice_floor) << c.name;
+    EXPECT_FALSE(scene.ground_contact) << c.name;
+    EXPECT_FALSE(scene.friction) << c.name;  // feet switch on the spheres
+    EXPECT_EQ(scene.lattice_floor_spec.feet.size(), 2u) << c.name;
+    EXPECT_EQ(scene.materials.at("bladder_5").number("mu"), 1388889) << c.name;  // 12.5 x 111111 Pa
+    EXPECT_EQ(scene.materials.at("skin").number("mu"), 200000) << c.name;
+    EXPECT_EQ(doc["materials"]["bladder_3"]["density"].as<double>(), 15000) << c.name;
+    EXPECT_EQ(doc["materials"]["skin"]["density"].as<double>(), 2900) << c.name;
+  }
+  try {
+    robot_main({"validate", "--presets", "voxel,lattice"}, PETSC_COMM_WORLD);
+    FAIL() << "an unknown preset must be refused";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("lattice-mechanics"), std::string::npos) << e.what();
+  }
+}
+
 TEST(RobotStudy, CustomFidelityLevelsParseAndBadOnesAreRefused) {
   const RobotFidelity& l = find_robot_fidelity("0.01:2:0.1");
   EXPECT_DOUBLE_EQ(l.mesh_size, 0.01);
