@@ -495,25 +495,20 @@ int validate(const std::vector<std::string>& args, MPI_Comm comm) {
       fem = buf;
       rows.push_back(outcome_json(c, level, o));
     }
-    if (jp >= 0) {
-      const auto& o = outcomes[jp];
+    // A further preset's cells (speed, wall time) and its JSON row.
+    auto preset_cells = [&](int j, int speed_width, int wall_width, const char* preset) {
+      const auto& o = outcomes[j];
       char buf[96];
-      std::snprintf(buf, sizeof buf, "%+11.5f  %11.1f%s", o.speed, o.wall_s, o.completed > 0 ? "" : " FAILED");
-      phys = buf;
-      Json j = outcome_json(jobs[jp].first, level, o);
-      j.add("preset", "physical").add("template", jobs[jp].first.template_scene);
-      rows.push_back(j);
-    }
-    std::string lattmech;
-    if (jl >= 0) {
-      const auto& o = outcomes[jl];
-      char buf[96];
-      std::snprintf(buf, sizeof buf, "  %+13.5f  %15.1f%s", o.speed, o.wall_s, o.completed > 0 ? "" : " FAILED");
-      lattmech = buf;
-      Json j = outcome_json(jobs[jl].first, level, o);
-      j.add("preset", "lattice-mechanics");
-      rows.push_back(j);
-    }
+      std::snprintf(buf, sizeof buf, "%+*.5f  %*.1f%s", speed_width, o.speed, wall_width, o.wall_s,
+                    o.completed > 0 ? "" : " FAILED");
+      Json row = outcome_json(jobs[j].first, level, o);
+      row.add("preset", preset);
+      if (jobs[j].first.physical) row.add("template", jobs[j].first.template_scene);
+      rows.push_back(row);
+      return std::string(buf);
+    };
+    if (jp >= 0) phys = preset_cells(jp, 11, 11, "physical");
+    const std::string lattmech = jl >= 0 ? "  " + preset_cells(jl, 13, 15, "lattice-mechanics") : "";
     std::snprintf(line, sizeof line, "%-26s %5.1f  %6.1f  %7.0f  %+11.5f  %s  %s%s\n", c.name.c_str(), c.slope_deg,
                   c.schedule.orientation_deg, c.schedule.core_pressure_pa, c.voxel_bl_per_s, fem.c_str(), phys.c_str(),
                   lattmech.c_str());
