@@ -79,4 +79,13 @@ TimeFunction voxel_foot_friction(const Schedule& schedule, int foot_channel, dou
   return TimeFunction(table);
 }
 
+TimeFunction voxel_gap_foot_friction(const Schedule& schedule, double start, double mu_active, double mu_inactive,
+                                     const VoxelActuation& model, double switch_s) {
+  const VoxelTimeline timeline = voxel_timeline(schedule, model);
+  if (timeline.actuation_end.empty()) return TimeFunction::constant(mu_inactive);
+  const double raised = start + timeline.actuation_end.front();  // the first settle phase starts
+  switch_s = std::min(switch_s, 0.5 * model.step_s);
+  return TimeFunction({{raised, mu_inactive}, {raised + switch_s, mu_active}});
+}
+
 }  // namespace morphfem

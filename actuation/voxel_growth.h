@@ -61,4 +61,12 @@ StretchFunction voxel_bladder_growth(const Schedule& schedule, int bladder, doub
 TimeFunction voxel_foot_friction(const Schedule& schedule, int foot_channel, double start, double mu_active,
                                  double mu_inactive, const VoxelActuation& model = {}, double switch_s = 1e-3);
 
+// The study's third foot material (pancakerobot.jl, varF[3]: the foot voxels of the skin
+// columns between bladder groups, x = 4, 8, 12): inactive (mu_inactive) from the start,
+// raised to mu_active with every settle phase like the other feet, but never lowered again,
+// since the study's code switches only feet A and B per column. So: mu_inactive until
+// the first settle phase, mu_active from then on (switch over `switch_s` [s]).
+TimeFunction voxel_gap_foot_friction(const Schedule& schedule, double start, double mu_active, double mu_inactive,
+                                     const VoxelActuation& model = {}, double switch_s = 1e-3);
+
 }  // namespace morphfem

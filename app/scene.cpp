@@ -497,9 +497,10 @@ Scene scene_from_yaml(const YAML::Node& root, const std::string& path) {
     }
     if (const auto lf = c["lattice_floor"]) {
       const std::string key = "contact.lattice_floor";
-      r.allow(lf, key, {"point", "normal", "dhat", "kappa", "eps_v", "voxel_size", "mu"});
+      r.allow(lf, key, {"point", "normal", "dhat", "kappa", "eps_v", "voxel_size", "mu", "gap_foot_columns"});
       scene.lattice_floor = true;
       LatticeFloorScene& spec = scene.lattice_floor_spec;
+      if (lf["gap_foot_columns"]) spec.gap_foot_columns = r.flag(lf["gap_foot_columns"], key + ".gap_foot_columns");
       if (lf["point"]) spec.floor.point = r.vector3(lf["point"], key + ".point");
       if (lf["normal"]) {
         spec.floor.normal = r.vector3(lf["normal"], key + ".normal");
@@ -686,6 +687,13 @@ Scene scene_from_yaml(const YAML::Node& root, const std::string& path) {
           scene.friction_spec.regions.push_back({surface, mu, mu});
         else
           scene.lattice_floor_spec.feet.push_back({surface, mu});
+      }
+      LatticeFloorScene& lattice = scene.lattice_floor_spec;
+      if (lattice.gap_foot_columns && !scene.ground_contact) {
+        if (timing != "voxel")
+          r.fail(f, key + ".feet", "contact.lattice_floor.gap_foot_columns needs the voxel timing (growth actuation)");
+        lattice.gap_foot_mu = voxel_gap_foot_friction(*schedule, start, mu_active, mu_inactive, voxel);
+        lattice.gap_foot_mu_set = true;
       }
     }
   }

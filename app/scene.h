@@ -152,6 +152,13 @@ struct LatticeFloorScene {
   // actuation.feet without contact.ground: foot surface -> its friction mu(t), for the
   // skin voxels (both layers) over the foot's y range, as the lattice's foot voxels.
   std::vector<std::pair<std::string, TimeFunction>> feet;
+  // contact.lattice_floor.gap_foot_columns: the study's third foot material on the skin
+  // voxels of the feet's bands whose column holds no bladder (x = 4, 8, 12): its friction
+  // (voxel_gap_foot_friction: raised at the first settle phase, never lowered) and its
+  // voxels' x scale 0.9 (pancakerobot.jl), for the sphere radius.
+  bool gap_foot_columns = false;
+  TimeFunction gap_foot_mu;  // set by actuation.feet (voxel timing)
+  bool gap_foot_mu_set = false;
 };
 
 struct GaitSpec {

@@ -237,24 +237,39 @@ std::vector<LatticePoint> lattice_points(const Scene& scene, const Mesh& mesh) {
     }
     foot_ranges.push_back({{lo, hi}, mu});
   }
-  std::map<std::string, std::vector<int>> region_cells;
+  if (spec.gap_foot_columns && !spec.gap_foot_mu_set)
+    throw InputError(key + ".gap_foot_columns", "needs actuation.feet (foot_a, foot_b) with growth actuation");
+  const std::vector<LatticeVoxelBox> boxes = robot_voxel_lattice(scene.geometry, voxel, VoxelActuation{}.min_scale);
+  // A skin column holds a bladder if its centre lies in some bladder box's x range.
+  const auto under_bladder = [&boxes](double x) {
+    for (const LatticeVoxelBox& b : boxes)
+      if (b.region != "skin" && x > b.lo.x() && x < b.hi.x()) return true;
+    return false;
+  };
+  std::map<std::string, CellLocator> locators;  // per volume region
   std::vector<LatticePoint> points;
-  for (const LatticeVoxelBox& box : robot_voxel_lattice(scene.geometry, voxel, VoxelActuation{}.min_scale)) {
+  for (const LatticeVoxelBox& box : boxes) {
     const auto mu = spec.mu.find(box.region);
     if (mu == spec.mu.end())
       throw InputError(key + ".mu", "no friction coefficient for volume region '" + box.region + "'");
-    auto cells = region_cells.find(box.region);
-    if (cells == region_cells.end()) cells = region_cells.emplace(box.region, mesh.cells_of(box.region)).first;
+    auto locator = locators.find(box.region);
+    if (locator == locators.end()) locator = locators.try_emplace(box.region, mesh, mesh.cells_of(box.region)).first;
     LatticePoint p;
-    p.owner_cell = interpolation_weights(mesh, cells->second, 0.5 * (box.lo + box.hi), p.nodes, p.weights);
+    p.owner_cell = locator->second.weights(0.5 * (box.lo + box.hi), p.nodes, p.weights);
     p.area = (box.hi.x() - box.lo.x()) * (box.hi.y() - box.lo.y());
     p.mu = TimeFunction::constant(mu->second);
     const double y = 0.5 * (box.lo.y() + box.hi.y());
+    Eigen::Vector3d base = box.base_scale;
     if (box.region == "skin")
       for (const auto& [range, foot_mu] : foot_ranges)
-        if (y >= range.first && y <= range.second) p.mu = foot_mu;
+        if (y >= range.first && y <= range.second) {
+          p.mu = foot_mu;
+          if (spec.gap_foot_columns && !under_bladder(0.5 * (box.lo.x() + box.hi.x()))) {
+            p.mu = spec.gap_foot_mu;
+            base.x() *= 0.9;  // the study's varF[3] scale
+          }
+        }
     const auto g = growth.find(box.region);
-    const Eigen::Vector3d base = box.base_scale;
     if (g == growth.end())
       p.radius = [r = voxel * base.sum() / 6.0](double) { return r; };
     else

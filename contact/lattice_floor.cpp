@@ -17,35 +17,93 @@ namespace {
 const char* const kWhere = "contact.lattice_floor";
 }
 
-int interpolation_weights(const Mesh& mesh, const std::vector<int>& cells, const Eigen::Vector3d& X,
-                          std::vector<int>& nodes, std::vector<double>& weights) {
-  if (cells.empty()) throw InputError(kWhere, "a lattice voxel without cells");
-  int best = -1;
-  double best_min = -std::numeric_limits<double>::infinity();
-  Eigen::Vector3d best_xi = Eigen::Vector3d::Zero();
-  for (int e : cells) {
-    // X = x0 + [x1 - x0, x2 - x0, x3 - x0] xi (the vertices' affine map).
-    const Eigen::Vector3d x0 = mesh.X.row(mesh.cells(e, 0)).transpose();
-    Eigen::Matrix3d J;
-    for (int i = 0; i < 3; ++i) J.col(i) = mesh.X.row(mesh.cells(e, i + 1)).transpose() - x0;
-    const Eigen::Vector3d xi = J.inverse() * (X - x0);
-    const double smallest = std::min(1.0 - xi.sum(), xi.minCoeff());  // smallest barycentric coordinate
-    if (smallest > best_min) {
-      best_min = smallest;
-      best = e;
-      best_xi = xi;
-    }
-  }
+namespace {
+
+// The cell of cells[i], i in `positions`, whose smallest barycentric coordinate at X
+// is largest (the first one on ties), with that coordinate and X's local coordinates.
+struct Located {
+  int cell = -1;
+  double smallest = -std::numeric_limits<double>::infinity();
+  Eigen::Vector3d xi = Eigen::Vector3d::Zero();
+};
+
+void score(const Mesh& mesh, int e, const Eigen::Vector3d& X, Located& best) {
+  // X = x0 + [x1 - x0, x2 - x0, x3 - x0] xi (the vertices' affine map).
+  const Eigen::Vector3d x0 = mesh.X.row(mesh.cells(e, 0)).transpose();
+  Eigen::Matrix3d J;
+  for (int i = 0; i < 3; ++i) J.col(i) = mesh.X.row(mesh.cells(e, i + 1)).transpose() - x0;
+  const Eigen::Vector3d xi = J.inverse() * (X - x0);
+  const double smallest = std::min(1.0 - xi.sum(), xi.minCoeff());  // smallest barycentric coordinate
+  if (smallest > best.smallest) best = Located{e, smallest, xi};
+}
+
+int fill(const Mesh& mesh, const Located& best, std::vector<int>& nodes, std::vector<double>& weights) {
   Eigen::VectorXd N;
   Eigen::MatrixXd dN;
-  tet_shape(mesh.order, best_xi, N, dN);
+  tet_shape(mesh.order, best.xi, N, dN);
   nodes.resize(N.size());
   weights.resize(N.size());
   for (int a = 0; a < N.size(); ++a) {
-    nodes[a] = mesh.cells(best, a);
+    nodes[a] = mesh.cells(best.cell, a);
     weights[a] = N[a];
   }
-  return best;
+  return best.cell;
+}
+
+}  // namespace
+
+int interpolation_weights(const Mesh& mesh, const std::vector<int>& cells, const Eigen::Vector3d& X,
+                          std::vector<int>& nodes, std::vector<double>& weights) {
+  if (cells.empty()) throw InputError(kWhere, "a lattice voxel without cells");
+  Located best;
+  for (int e : cells) score(mesh, e, X, best);
+  return fill(mesh, best, nodes, weights);
+}
+
+namespace {
+// Bounding box [lo, hi] of cell e's vertices (its straight shape) [m].
+void vertex_box(const Mesh& mesh, int e, Eigen::Vector3d& lo, Eigen::Vector3d& hi) {
+  lo = hi = mesh.X.row(mesh.cells(e, 0)).transpose();
+  for (int a = 1; a < 4; ++a) {
+    lo = lo.cwiseMin(mesh.X.row(mesh.cells(e, a)).transpose());
+    hi = hi.cwiseMax(mesh.X.row(mesh.cells(e, a)).transpose());
+  }
+}
+
+// Mean largest extent [m] of the cells' vertex boxes (the grid spacing).
+double mean_cell_size(const Mesh& mesh, const std::vector<int>& cells) {
+  if (cells.empty()) throw InputError(kWhere, "a lattice voxel without cells");
+  double sum = 0.0;
+  Eigen::Vector3d lo, hi;
+  for (int e : cells) {
+    vertex_box(mesh, e, lo, hi);
+    sum += (hi - lo).maxCoeff();
+  }
+  return sum / static_cast<double>(cells.size());
+}
+}  // namespace
+
+CellLocator::CellLocator(const Mesh& mesh, std::vector<int> cells)
+    : mesh_(mesh), cells_(std::move(cells)), grid_(mean_cell_size(mesh, cells_)) {
+  for (size_t i = 0; i < cells_.size(); ++i) {
+    Eigen::Vector3d lo, hi;
+    vertex_box(mesh, cells_[i], lo, hi);
+    // Widened by a rounding margin, so a point that a cell contains up to the
+    // barycentric round-off is still listed with it.
+    const Eigen::Vector3d margin = Eigen::Vector3d::Constant(1e-9 * (hi - lo).maxCoeff());
+    grid_.insert(static_cast<int>(i), lo - margin, hi + margin);
+  }
+}
+
+int CellLocator::weights(const Eigen::Vector3d& X, std::vector<int>& nodes, std::vector<double>& weights) const {
+  Located best;
+  if (const std::vector<int>* listed = grid_.at(X))
+    for (int i : *listed) score(mesh_, cells_[i], X, best);  // listed in cells_ order
+  if (!(best.smallest >= 0.0)) {                             // no listed cell contains X: the nearest of all
+    best = Located{};
+    for (int e : cells_) score(mesh_, e, X, best);
+  }
+  return fill(mesh_, best, nodes, weights);
 }
 
 LatticeFloorTerm::LatticeFloorTerm(const Mesh& mesh, const Partition& partition, int rank, LatticeFloorSpec spec,

@@ -9,6 +9,7 @@
 #include <tuple>
 
 #include "contact/barrier.h"
+#include "contact/box_grid.h"
 #include "contact/ground.h"
 #include "core/errors.h"
 
@@ -323,13 +324,6 @@ void collect_edges(const RowMatrixXd& X, const std::vector<std::array<int, 3>>& 
   }
 }
 
-// Integer cell of a uniform grid with spacing `size` [m].
-using Cell = std::tuple<long, long, long>;
-Cell grid_cell(const Eigen::Vector3d& y, double size) {
-  return {static_cast<long>(std::floor(y[0] / size)), static_cast<long>(std::floor(y[1] / size)),
-          static_cast<long>(std::floor(y[2] / size))};
-}
-
 // The node sets of the surface pairs, merged where pairs share a node: the groups
 // whose candidates a rigid motion of the group's nodes leaves unchanged.
 template <class Sides>
@@ -448,22 +442,18 @@ void SelfContactTerm::build_candidates(const RowMatrixXd& x) {
       double size = search;
       for (const auto& t : tris->triangles)
         for (int i = 0; i < 3; ++i) size = std::max(size, (x.row(t[i]) - x.row(t[(i + 1) % 3])).cwiseAbs().maxCoeff());
-      std::map<Cell, std::vector<int>> grid;
+      BoxGrid grid(size);
       for (size_t t = 0; t < tris->triangles.size(); ++t) {
         Eigen::Vector3d lo, hi;
         box(tris->triangles[t], lo, hi);
-        const auto [x0, y0, z0] = grid_cell((lo.array() - search).matrix(), size);
-        const auto [x1, y1, z1] = grid_cell((hi.array() + search).matrix(), size);
-        for (long i = x0; i <= x1; ++i)
-          for (long j = y0; j <= y1; ++j)
-            for (long k = z0; k <= z1; ++k) grid[{i, j, k}].push_back(static_cast<int>(t));
+        grid.insert(static_cast<int>(t), (lo.array() - search).matrix(), (hi.array() + search).matrix());
       }
       for (int p : points->points) {
         const bool owned = p >= rank_begin_ && p < rank_end_;
         if (!owned && !far) continue;
-        const auto it = grid.find(grid_cell(x.row(p).transpose(), size));
-        if (it == grid.end()) continue;
-        for (int t : it->second) {
+        const std::vector<int>* listed = grid.at(x.row(p).transpose());
+        if (listed == nullptr) continue;
+        for (int t : *listed) {
           const auto& tri = tris->triangles[t];
           const int face = tris->triangle_face[t];
           bool own = false;
@@ -488,30 +478,19 @@ void SelfContactTerm::build_candidates(const RowMatrixXd& x) {
     double size = search;
     for (const auto& e : side_b.edges) size = std::max(size, (x.row(e[0]) - x.row(e[1])).cwiseAbs().maxCoeff());
     for (const auto& e : side_a.edges) size = std::max(size, (x.row(e[0]) - x.row(e[1])).cwiseAbs().maxCoeff());
-    std::map<Cell, std::vector<int>> grid;
+    BoxGrid grid(size);
     for (size_t k = 0; k < side_b.edges.size(); ++k) {
       Eigen::Vector3d lo, hi;
       box(side_b.edges[k], lo, hi);
-      const auto [x0, y0, z0] = grid_cell((lo.array() - search).matrix(), size);
-      const auto [x1, y1, z1] = grid_cell((hi.array() + search).matrix(), size);
-      for (long i = x0; i <= x1; ++i)
-        for (long j = y0; j <= y1; ++j)
-          for (long l = z0; l <= z1; ++l) grid[{i, j, l}].push_back(static_cast<int>(k));
+      grid.insert(static_cast<int>(k), (lo.array() - search).matrix(), (hi.array() + search).matrix());
     }
     std::set<int> near;
     for (size_t ka = 0; ka < side_a.edges.size(); ++ka) {
       const auto& ea = side_a.edges[ka];
       Eigen::Vector3d lo, hi;
       box(ea, lo, hi);
-      const auto [x0, y0, z0] = grid_cell(lo, size);
-      const auto [x1, y1, z1] = grid_cell(hi, size);
       near.clear();
-      for (long i = x0; i <= x1; ++i)
-        for (long j = y0; j <= y1; ++j)
-          for (long l = z0; l <= z1; ++l) {
-            const auto it = grid.find({i, j, l});
-            if (it != grid.end()) near.insert(it->second.begin(), it->second.end());
-          }
+      grid.near(lo, hi, near);
       for (int kb : near) {
         const auto& eb = side_b.edges[kb];
         if (ea[0] == eb[0] || ea[0] == eb[1] || ea[1] == eb[0] || ea[1] == eb[1]) continue;

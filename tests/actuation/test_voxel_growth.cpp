@@ -65,3 +65,25 @@ TEST(VoxelGrowth, FeetFollowTheirRowsOnlyDuringActuationPhases) {
   EXPECT_EQ(mu(1.0 + 0.5 * (timeline.column_start[1] + timeline.actuation_end[1])), 2.0);  // column 2: active
   EXPECT_EQ(mu(1.0 + timeline.duration() + 1.0), 2.0);
 }
+
+// The gap columns' feet (the study's varF[3]): inactive while settling and in column
+// 1's actuation phase, active from its settle phase on, also in columns where feet A
+// and B are inactive.
+TEST(VoxelGrowth, GapColumnFeetStayActiveFromTheFirstSettlePhase) {
+  const VoxelActuation model;
+  ScheduleMatrix m(kNumRows, std::vector<int>(8, 0));
+  for (int k = 0; k < 8; ++k) m[k][k] = 1;  // rolling: feet A and B inactive in every column
+  const Schedule s = Schedule::from_matrix(m, 1.237, 2);
+  const VoxelTimeline timeline = voxel_timeline(s, model);
+  const TimeFunction mu = voxel_gap_foot_friction(s, 1.0, 2.0, 1e-4, model);
+  const TimeFunction foot_a = voxel_foot_friction(s, kChannelFootA, 1.0, 2.0, 1e-4, model);
+  EXPECT_EQ(mu(0.5), 1e-4);                                            // settling before the gait
+  EXPECT_EQ(mu(1.0 + 0.5 * timeline.actuation_end[0]), 1e-4);          // column 1's actuation
+  EXPECT_EQ(mu(1.0 + timeline.actuation_end[0] + model.step_s), 2.0);  // its settle phase
+  for (size_t k = 1; k < timeline.column_start.size(); ++k) {          // every later actuation phase
+    const double t = 1.0 + 0.5 * (timeline.column_start[k] + timeline.actuation_end[k]);
+    EXPECT_EQ(mu(t), 2.0) << k;
+    EXPECT_NEAR(foot_a(t), 1e-4, 1e-15) << k;  // while feet A and B are inactive
+  }
+  EXPECT_EQ(mu(1.0 + timeline.duration() + 1.0), 2.0);
+}

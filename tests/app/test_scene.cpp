@@ -551,18 +551,27 @@ TEST(Scene, LatticeFloorHoldsTheVoxelSliceOnItsSpheres) {
 // gait, inactive in the rolling gait's actuation phases), other skin voxels the skin's,
 // bladder voxels theirs; a deflated bladder voxel's sphere has radius L 2.2/6, a skin
 // voxel's L/2, and an inflated one's L (s_x + s_y + 2.5)/6.
-TEST(Scene, LatticePointsOfTheVoxelPresetCarryFeetAndGrowingRadii) {
+namespace {
+// examples/voxel/roll_flat.yaml at 2 cm on the lattice floor; `extra` adds keys to it.
+std::string voxel_lattice_scene(const std::string& extra = "") {
   std::ifstream in(std::string(MORPHFEM_SOURCE_DIR) + "/examples/voxel/roll_flat.yaml");
   std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   const auto from = text.find("\ncontact:"), to = text.find("\ndynamics:");
-  ASSERT_NE(from, std::string::npos);
+  if (from == std::string::npos) return "";
   text.replace(from, to - from,
                "\ncontact:\n  lattice_floor: {point: [0, 0, -0.003], kappa: 6.0e5, mu: {skin: 2.0, bladder_1: 0.5, "
                "bladder_2: 0.5, bladder_3: 0.5, bladder_4: 0.5, bladder_5: 0.5, bladder_6: 0.5, bladder_7: 0.5, "
-               "bladder_8: 0.5}}");
+               "bladder_8: 0.5}" +
+                   extra + "}");
   text =
       replace(text, "../schedules/rolling.yaml", std::string(MORPHFEM_SOURCE_DIR) + "/examples/schedules/rolling.yaml");
-  text = replace(text, "mesh_size: 0.015", "mesh_size: 0.02");
+  return replace(text, "mesh_size: 0.015", "mesh_size: 0.02");
+}
+}  // namespace
+
+TEST(Scene, LatticePointsOfTheVoxelPresetCarryFeetAndGrowingRadii) {
+  const std::string text = voxel_lattice_scene();
+  ASSERT_FALSE(text.empty());
   TempScene s(text);
   const Scene scene = read_scene(s.file.string());
   ASSERT_TRUE(scene.lattice_floor);
@@ -599,4 +608,53 @@ TEST(Scene, LatticePointsOfTheVoxelPresetCarryFeetAndGrowingRadii) {
   EXPECT_EQ(skin, 660 - feet);
   EXPECT_EQ(bladders, 768);
   EXPECT_EQ(grown, 3 * 16 * 2);  // bladder 8's voxels
+}
+
+// gap_foot_columns: the feet's skin voxels in the columns without a bladder (x = 4, 8,
+// 12 of 15) take the study's third foot material: inactive while settling and in column
+// 1, active from column 1's settle phase on even while feet A and B are inactive, and
+// a sphere of radius L (0.9 + 1 + 1)/6. Bad combinations are refused.
+TEST(Scene, LatticeGapFootColumnsStayActiveAfterTheFirstSettlePhase) {
+  TempScene s(voxel_lattice_scene(", gap_foot_columns: true"));
+  const Scene scene = read_scene(s.file.string());
+  const Mesh mesh = build_scene_mesh(scene, PETSC_COMM_WORLD);
+  const std::vector<LatticePoint> points = lattice_points(scene, mesh);
+  ASSERT_EQ(points.size(), 1428u);
+  const double t_column1 = 1.5 + 0.1, t_column2 = 1.5 + 1.237 + 0.1;  // actuation phases, feet A, B inactive
+  int gap = 0, feet = 0;
+  for (const LatticePoint& p : points) {
+    Eigen::Vector3d X = Eigen::Vector3d::Zero();
+    for (size_t a = 0; a < p.nodes.size(); ++a) X += p.weights[a] * mesh.X.row(p.nodes[a]).transpose();
+    if (std::abs(p.radius(0.0) - 0.01 * 2.9 / 6.0) < 1e-12) {
+      ++gap;
+      EXPECT_TRUE(X.y() < 0.03 || X.y() > 0.19) << X.transpose();
+      const int column = static_cast<int>(std::floor(X.x() / 0.01)) + 1;
+      EXPECT_TRUE(column == 4 || column == 8 || column == 12) << column;
+      EXPECT_EQ(p.mu(0.0), 1e-4);
+      EXPECT_EQ(p.mu(t_column1), 1e-4);
+      EXPECT_EQ(p.mu(t_column2), 2.0);
+    } else if (std::abs(p.radius(0.0) - 0.005) < 1e-12 && (X.y() < 0.03 || X.y() > 0.19)) {
+      ++feet;
+      EXPECT_NEAR(p.mu(t_column2), 1e-4, 1e-12);
+    }
+  }
+  EXPECT_EQ(gap, 2 * 2 * 3 * 3);  // two feet, both layers, 3 columns x 3 rows
+  EXPECT_EQ(feet, 2 * 2 * 12 * 3);
+
+  // Without actuation.feet there is nothing to take the timing from.
+  std::string text = voxel_lattice_scene(", gap_foot_columns: true");
+  const auto feet_key = text.find("  feet:");
+  ASSERT_NE(feet_key, std::string::npos);
+  text.erase(feet_key, text.find('\n', feet_key) + 1 - feet_key);
+  TempScene no_feet(text);
+  const Scene bare = read_scene(no_feet.file.string());
+  const Mesh bare_mesh = build_scene_mesh(bare, PETSC_COMM_WORLD);
+  try {
+    lattice_points(bare, bare_mesh);
+    ADD_FAILURE() << "gap_foot_columns without feet was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("gap_foot_columns"), std::string::npos) << e.what();
+  }
+  const std::string bad = error_of(voxel_lattice_scene(", gap_foot_columns: maybe"));
+  EXPECT_NE(bad.find("contact.lattice_floor.gap_foot_columns"), std::string::npos) << bad;
 }

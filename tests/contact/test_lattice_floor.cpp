@@ -96,6 +96,36 @@ TEST(LatticeFloor, InterpolationWeightsFollowAffineMotionFromTheContainingCell) 
   EXPECT_THROW(interpolation_weights(mesh, {}, Eigen::Vector3d::Zero(), nodes, w), InputError);
 }
 
+// The grid-narrowed locator picks the same cell (so the same weights) as the full
+// scan, for random points inside and outside the block and for points on the
+// mesh's vertices, edges and faces (a lattice of 2.5 mm steps over a 5 mm mesh),
+// where several cells contain the point.
+TEST(LatticeFloor, CellLocatorFindsTheFullScansCell) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> x(-0.004, 0.024), yz(-0.002, 0.012);
+  for (int order : {1, 2}) {
+    const Mesh mesh = block(order);
+    const CellLocator locator(mesh, all_cells(mesh));
+    std::vector<Eigen::Vector3d> points;
+    for (int k = 0; k < 300; ++k) points.emplace_back(x(rng), yz(rng), yz(rng));
+    for (int i = 0; i <= 8; ++i)
+      for (int j = 0; j <= 4; ++j)
+        for (int l = 0; l <= 4; ++l) points.emplace_back(0.0025 * i, 0.0025 * j, 0.0025 * l);
+    int outside = 0;
+    for (const Eigen::Vector3d& X : points) {
+      std::vector<int> nodes_scan, nodes_grid;
+      std::vector<double> w_scan, w_grid;
+      const int scan = interpolation_weights(mesh, all_cells(mesh), X, nodes_scan, w_scan);
+      ASSERT_EQ(locator.weights(X, nodes_grid, w_grid), scan) << order << " X = " << X.transpose();
+      EXPECT_EQ(nodes_grid, nodes_scan);
+      EXPECT_EQ(w_grid, w_scan);
+      outside += X.x() < 0 || X.x() > 0.02 || X.y() < 0 || X.y() > 0.01 || X.z() < 0 || X.z() > 0.01;
+    }
+    EXPECT_GT(outside, 50) << "the random points must test the fall-back to the full scan";
+  }
+  EXPECT_THROW(CellLocator(block(1), {}), InputError);
+}
+
 // Barrier and friction together, exact Hessian, slips in the stick range, the
 // smoothing's end and sliding; P1 and P2 points.
 TEST(LatticeFloor, GradientAndHessianMatchFiniteDifferences) {
