@@ -37,7 +37,9 @@ const char* kSearchUsage =
     "  --quiet                   no progress line\n"
     "  --eval-delay-ms MS        sleep before every evaluation (tests)\n"
     "  --list                    experiments, methods and fitnesses\n"
-    "Runs unchanged under mpirun; a killed run resumes where it stopped when started again with the same options.\n";
+    "Runs unchanged under mpirun. A killed run, started again with the same options, resumes from its last\n"
+    "checkpoint, written after every step: a generation of the hill climber, an iteration of CMA-ES (lambda\n"
+    "evaluations per run, or what is left of the budget), so evaluations of an unfinished step are redone.\n";
 
 std::vector<std::string> split_list(const std::string& s) {
   std::vector<std::string> out;
