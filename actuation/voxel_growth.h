@@ -66,6 +66,8 @@ TimeFunction voxel_foot_friction(const Schedule& schedule, int foot_channel, dou
 // raised to mu_active with every settle phase like the other feet, but never lowered again,
 // since the study's code switches only feet A and B per column. So: mu_inactive until
 // the first settle phase, mu_active from then on (switch over `switch_s` [s]).
+// Those voxels' x scale (the study's setExternalScaleFactor(varF[3], 0.9, 1, 1)).
+constexpr double kVoxelGapFootScaleX = 0.9;
 TimeFunction voxel_gap_foot_friction(const Schedule& schedule, double start, double mu_active, double mu_inactive,
                                      const VoxelActuation& model = {}, double switch_s = 1e-3);
 

@@ -693,7 +693,6 @@ Scene scene_from_yaml(const YAML::Node& root, const std::string& path) {
         if (timing != "voxel")
           r.fail(f, key + ".feet", "contact.lattice_floor.gap_foot_columns needs the voxel timing (growth actuation)");
         lattice.gap_foot_mu = voxel_gap_foot_friction(*schedule, start, mu_active, mu_inactive, voxel);
-        lattice.gap_foot_mu_set = true;
       }
     }
   }

@@ -109,6 +109,7 @@
 #include <array>
 #include <functional>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -157,8 +158,7 @@ struct LatticeFloorScene {
   // (voxel_gap_foot_friction: raised at the first settle phase, never lowered) and its
   // voxels' x scale 0.9 (pancakerobot.jl), for the sphere radius.
   bool gap_foot_columns = false;
-  TimeFunction gap_foot_mu;  // set by actuation.feet (voxel timing)
-  bool gap_foot_mu_set = false;
+  std::optional<TimeFunction> gap_foot_mu;  // set by actuation.feet (voxel timing)
 };
 
 struct GaitSpec {

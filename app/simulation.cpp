@@ -237,7 +237,7 @@ std::vector<LatticePoint> lattice_points(const Scene& scene, const Mesh& mesh) {
     }
     foot_ranges.push_back({{lo, hi}, mu});
   }
-  if (spec.gap_foot_columns && !spec.gap_foot_mu_set)
+  if (spec.gap_foot_columns && !spec.gap_foot_mu)
     throw InputError(key + ".gap_foot_columns", "needs actuation.feet (foot_a, foot_b) with growth actuation");
   const std::vector<LatticeVoxelBox> boxes = robot_voxel_lattice(scene.geometry, voxel, VoxelActuation{}.min_scale);
   // A skin column holds a bladder if its centre lies in some bladder box's x range.
@@ -265,8 +265,8 @@ std::vector<LatticePoint> lattice_points(const Scene& scene, const Mesh& mesh) {
         if (y >= range.first && y <= range.second) {
           p.mu = foot_mu;
           if (spec.gap_foot_columns && !under_bladder(0.5 * (box.lo.x() + box.hi.x()))) {
-            p.mu = spec.gap_foot_mu;
-            base.x() *= 0.9;  // the study's varF[3] scale
+            p.mu = *spec.gap_foot_mu;
+            base.x() *= kVoxelGapFootScaleX;
           }
         }
     const auto g = growth.find(box.region);

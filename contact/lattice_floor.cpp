@@ -14,13 +14,11 @@
 namespace morphfem {
 
 namespace {
+
 const char* const kWhere = "contact.lattice_floor";
-}
 
-namespace {
-
-// The cell of cells[i], i in `positions`, whose smallest barycentric coordinate at X
-// is largest (the first one on ties), with that coordinate and X's local coordinates.
+// Of the cells scored so far, the one whose smallest barycentric coordinate at X is
+// largest (the first one on ties), with that coordinate and X's local coordinates.
 struct Located {
   int cell = -1;
   double smallest = -std::numeric_limits<double>::infinity();
@@ -61,6 +59,7 @@ int interpolation_weights(const Mesh& mesh, const std::vector<int>& cells, const
 }
 
 namespace {
+
 // Bounding box [lo, hi] of cell e's vertices (its straight shape) [m].
 void vertex_box(const Mesh& mesh, int e, Eigen::Vector3d& lo, Eigen::Vector3d& hi) {
   lo = hi = mesh.X.row(mesh.cells(e, 0)).transpose();
@@ -81,6 +80,7 @@ double mean_cell_size(const Mesh& mesh, const std::vector<int>& cells) {
   }
   return sum / static_cast<double>(cells.size());
 }
+
 }  // namespace
 
 CellLocator::CellLocator(const Mesh& mesh, std::vector<int> cells)
