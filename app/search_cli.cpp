@@ -38,8 +38,9 @@ const char* kSearchUsage =
     "  --eval-delay-ms MS        sleep before every evaluation (tests)\n"
     "  --list                    experiments, methods and fitnesses\n"
     "Runs unchanged under mpirun. A killed run, started again with the same options, resumes from its last\n"
-    "checkpoint, written after every step: a generation of the hill climber, an iteration of CMA-ES (lambda\n"
-    "evaluations per run, or what is left of the budget), so evaluations of an unfinished step are redone.\n";
+    "checkpoint, written after every step (a generation of the hill climber, an iteration of CMA-ES), and\n"
+    "reuses the evaluations of the unfinished step saved as each finished (partial_team_K.h5): only the\n"
+    "evaluations that were running are redone.\n";
 
 std::vector<std::string> split_list(const std::string& s) {
   std::vector<std::string> out;

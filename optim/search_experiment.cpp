@@ -15,6 +15,7 @@
 #include "core/progress.h"
 #include "optim/checkpoint.h"
 #include "optim/search_method.h"
+#include "optim/search_partial.h"
 #include "optim/search_stats.h"
 
 namespace morphfem {
@@ -52,33 +53,6 @@ int rank_of(MPI_Comm comm) {
   int r = 0;
   MPI_Comm_rank(comm, &r);
   return r;
-}
-
-// The metadata a checkpoint must share with the run that resumes it.
-void put_metadata(SearchState& s, const ExperimentSpec& spec, const std::string& method, const SearchOptions& o) {
-  s.integers["format"] = kCheckpointFormat;
-  s.integers["seed"] = static_cast<long>(o.seed);
-  s.integers["climbers"] = o.climbers;
-  s.texts["experiment"] = spec.name;
-  s.texts["method"] = method;
-  s.texts["fitness"] = o.fitness;
-  s.texts["fidelity"] = o.fidelity;
-}
-
-void check_metadata(const SearchState& found, const SearchState& expected, const std::string& path) {
-  for (const auto& [key, value] : expected.integers) {
-    const long got = found.integer(key, path);
-    if (got != value)
-      throw InputError(path, "checkpoint was written with " + key + " = " + std::to_string(got) + ", this run has " +
-                                 std::to_string(value) + " (use --restart or another --out)");
-  }
-  for (const auto& [key, value] : expected.texts) {
-    auto it = found.texts.find(key);
-    if (it == found.texts.end()) throw InputError(path, "checkpoint has no '" + key + "'");
-    if (it->second != value)
-      throw InputError(path, "checkpoint was written with " + key + " = '" + it->second + "', this run has '" + value +
-                                 "' (use --restart or another --out)");
-  }
 }
 
 std::string validation_csv(const ExperimentResult& r) {
@@ -145,13 +119,16 @@ class SearchRunner {
   }
 
   // Evaluates a batch and adds its wall time to the session's cost measurement.
+  // Speeds in `known` (an interrupted step's saved evaluations) are not evaluated or counted.
   std::vector<double> evaluate(const std::vector<Genome>& genomes, const Environment& env, const std::string& fidelity,
-                               const std::function<void(long)>& on_done = nullptr) {
+                               const std::function<void(long)>& on_done = nullptr, const BatchSpeeds& known = {},
+                               const std::function<void(std::size_t, double)>& on_result = nullptr) {
     const auto t0 = std::chrono::steady_clock::now();
     auto out = teams_.evaluate(
-        genomes, [&](const Genome& g, MPI_Comm team) { return speed(g, env, fidelity, team); }, on_done);
+        genomes, [&](const Genome& g, MPI_Comm team) { return speed(g, env, fidelity, team); }, on_done, known,
+        on_result);
     wall_s_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    evaluations_ += static_cast<long>(genomes.size());
+    evaluations_ += static_cast<long>(genomes.size() - known.size());
     return out;
   }
 
@@ -187,11 +164,13 @@ ExperimentResult SearchRunner::run(const ExperimentSpec& spec, const std::string
   setup.seed = o_.seed;
   auto method = make_search_method(method_name, setup);
 
-  SearchState meta;
-  put_metadata(meta, spec, method_name, o_);
+  const SearchState meta = search_metadata(spec, method_name, o_);
   if (root_) {
     std::filesystem::create_directories(r.dir);
-    if (o_.restart) std::filesystem::remove(checkpoint);
+    if (o_.restart) {
+      std::filesystem::remove(checkpoint);
+      remove_partial_steps(r.dir);
+    }
   }
   MPI_Barrier(teams_.world());
   SearchState state;
@@ -202,10 +181,12 @@ ExperimentResult SearchRunner::run(const ExperimentSpec& spec, const std::string
     r.resumed = true;
   }
 
-  // The bar and its ETA cover this session's work only (a resumed run starts part way).
-  const double resumed_evaluations = static_cast<double>(method->evaluations()) * o_.climbers;
-  const double total = static_cast<double>(o_.climbers) * (o_.generations + 1) - resumed_evaluations;
-  Progress progress("search " + spec.name + "/" + method_name, total, o_.progress && total > 0);
+  // The bar covers the whole run; its ETA extrapolates this session's rate only (a
+  // resumed run starts part way, and reused evaluations of a step take no time).
+  double resumed_evaluations = static_cast<double>(method->evaluations()) * o_.climbers;
+  const double total = static_cast<double>(o_.climbers) * (o_.generations + 1);
+  Progress progress("search " + spec.name + "/" + method_name, total, o_.progress && total > resumed_evaluations);
+  progress.set_resumed_from(resumed_evaluations);
   const long evaluations_before = evaluations_;
   const double wall_before = wall_s_;
   auto save = [&]() {
@@ -219,7 +200,29 @@ ExperimentResult SearchRunner::run(const ExperimentSpec& spec, const std::string
   const auto session_start = std::chrono::steady_clock::now();
   while (!method->done()) {
     const std::vector<Genome> genomes = method->propose();
-    const double done_before = static_cast<double>(method->evaluations()) * o_.climbers;
+    // Evaluations of this step that a killed session saved are reused, not redone
+    // (optim/search_partial.h); every rank reads the same files before any team
+    // leader rewrites its own.
+    const long step = method->steps();
+    const PartialSteps partial = read_partial_steps(r.dir, meta, step, genomes);
+    MPI_Barrier(teams_.world());
+    if (!partial.speeds.empty()) {
+      r.evaluations_reused += static_cast<long>(partial.speeds.size());
+      r.resumed = true;
+      resumed_evaluations += static_cast<double>(partial.speeds.size());
+      progress.set_resumed_from(resumed_evaluations);
+      if (root_ && o_.progress)
+        std::fprintf(stderr, "search %s/%s: %zu evaluation(s) of step %ld reused from %s/partial_team_*.h5\n",
+                     spec.name.c_str(), method_name.c_str(), partial.speeds.size(), step, r.dir.c_str());
+    }
+    BatchSpeeds saved = partial.speeds;  // this team's partial file: the reused speeds and its own
+    const std::string partial_file = partial_step_path(r.dir, teams_.team());
+    auto on_result = [&](std::size_t i, double v) {
+      saved[i] = v;
+      write_partial_step(partial_file, meta, step, genomes, saved);
+    };
+    const double done_before =
+        static_cast<double>(method->evaluations()) * o_.climbers + static_cast<double>(partial.speeds.size());
     // Progress: generation, best so far, evaluations per hour of this session, ETA (core/progress.h).
     auto on_done = [&](long k) {
       const double session = static_cast<double>(evaluations_ - evaluations_before + k);
@@ -228,11 +231,13 @@ ExperimentResult SearchRunner::run(const ExperimentSpec& spec, const std::string
       char info[160];
       std::snprintf(info, sizeof info, "gen %ld/%d best %s BL/s %.3g evals/h", method->evaluations(), o_.generations,
                     h.empty() ? "-" : fixed(max_of(h.back())).c_str(), elapsed > 0 ? 3600.0 * session / elapsed : 0.0);
-      progress.update(done_before + k - resumed_evaluations, info);
+      progress.update(done_before + k, info);
     };
-    const std::vector<double> speeds = evaluate(genomes, spec.env, o_.fidelity, on_done);
+    const std::vector<double> speeds = evaluate(genomes, spec.env, o_.fidelity, on_done, partial.speeds, on_result);
     method->accept(speeds);
     save();
+    if (root_) remove_partial_steps(r.dir);  // the checkpoint now holds the whole step
+    MPI_Barrier(teams_.world());             // before any rank looks for the next step's files
   }
   progress.finish("best " + fixed(max_of(method->best_speeds())) + " BL/s");
   r.evaluations_timed = evaluations_ - evaluations_before;
@@ -373,6 +378,18 @@ std::vector<std::vector<double>> read_history_csv(const std::string& path) {
   return h;
 }
 
+SearchState search_metadata(const ExperimentSpec& spec, const std::string& method, const SearchOptions& o) {
+  SearchState s;
+  s.integers["format"] = kCheckpointFormat;
+  s.integers["seed"] = static_cast<long>(o.seed);
+  s.integers["climbers"] = o.climbers;
+  s.texts["experiment"] = spec.name;
+  s.texts["method"] = method;
+  s.texts["fitness"] = o.fitness;
+  s.texts["fidelity"] = o.fidelity;
+  return s;
+}
+
 SearchReport run_search(const SearchOptions& o, MPI_Comm comm) {
   if (o.climbers < 1) throw InputError("--climbers", "must be >= 1");
   if (o.generations < 0) throw InputError("--generations", "must be >= 0");
@@ -487,7 +504,8 @@ std::string summary_json(const SearchReport& report, const SearchOptions& o) {
         .add("best_speeds", r.best_speed)
         .add("resumed", r.resumed)
         .add("evaluation_wall_s", r.evaluation_wall_s)
-        .add("evaluations_timed", r.evaluations_timed);
+        .add("evaluations_timed", r.evaluations_timed)
+        .add("evaluations_reused", r.evaluations_reused);
     if (!r.validation_speed.empty())
       e.add("validation_speeds", r.validation_speed).add("spearman", r.spearman).add("kendall", r.kendall);
     experiments.push_back(e);

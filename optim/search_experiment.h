@@ -1,5 +1,6 @@
 // The study's search experiments and the loop that runs them: climbers spread over
-// MPI ranks, a checkpoint after every step, resume from the checkpoint, results in
+// MPI ranks, a checkpoint after every step and every evaluation saved as it
+// finishes, resume from both, results in
 // the voxel study's layout, re-evaluation at a validation fidelity, and the
 // summary table beside the voxel study's numbers.
 //
@@ -16,6 +17,8 @@
 // Output (DIR = --out):
 //   DIR/<experiment>/<method>/<experiment>.csv   best speed so far, "g,f_1,...,f_N", rows g = 0..G
 //   DIR/<experiment>/<method>/checkpoint.h5      full state after the last completed step
+//   DIR/<experiment>/<method>/partial_team_K.h5  evaluations of the unfinished step so far
+//                                                (optim/search_partial.h; gone when it completes)
 //   DIR/<experiment>/<method>/best/climber_NN.yaml   final best genome as a schedule file
 //   DIR/<experiment>/<method>/validation.csv     search vs validation speed per climber (if asked)
 //   DIR/summary.md, DIR/summary.json             the table; summary.json also drives the plots
@@ -28,6 +31,7 @@
 
 #include "optim/fitness.h"
 #include "optim/genome.h"
+#include "optim/search_method.h"
 #include "optim/search_parallel.h"
 
 namespace morphfem {
@@ -72,6 +76,7 @@ struct ExperimentResult {
   double spearman = 0, kendall = 0;
   long evaluations = 0;          // all climbers, whole run
   long evaluations_timed = 0;    // evaluated in this session
+  long evaluations_reused = 0;   // saved by a killed session part way through a step (optim/search_partial.h)
   double evaluation_wall_s = 0;  // wall time of this session's evaluations
   bool resumed = false;
 };
@@ -90,6 +95,10 @@ struct SearchReport {
   // Measured cost: wall seconds per evaluation of one team (ranks_per_sim ranks).
   double seconds_per_evaluation = 0;
 };
+
+// The metadata a checkpoint (and a partial step file) shares with the run that
+// resumes it: format, seed, climbers, experiment, method, fitness, fidelity.
+SearchState search_metadata(const ExperimentSpec& spec, const std::string& method, const SearchOptions& options);
 
 // Runs every (experiment, method) of `options` on all ranks of `comm`; rank 0
 // writes the files. Throws InputError for bad options or a mismatched checkpoint.

@@ -27,11 +27,22 @@ EvaluationTeams::~EvaluationTeams() {
 
 std::vector<double> EvaluationTeams::evaluate(const std::vector<Genome>& genomes,
                                               const std::function<double(const Genome&, MPI_Comm)>& speed,
-                                              const std::function<void(long)>& on_done) const {
+                                              const std::function<void(long)>& on_done,
+                                              const std::map<std::size_t, double>& known,
+                                              const std::function<void(std::size_t, double)>& on_result) const {
   const double kFailed = -std::numeric_limits<double>::infinity();
   std::vector<double> local(genomes.size(), kFailed), all(genomes.size(), kFailed);
+  std::vector<std::size_t> pending;
+  for (std::size_t i = 0; i < genomes.size(); ++i) {
+    auto it = known.find(i);
+    if (it == known.end())
+      pending.push_back(i);
+    else
+      local[i] = it->second;  // the same value on every rank: the reduction keeps it exactly
+  }
   long mine = 0;
-  for (size_t i = team_; i < genomes.size(); i += teams_) {
+  for (std::size_t j = team_; j < pending.size(); j += teams_) {
+    const std::size_t i = pending[j];
     double v = kFailed;
     try {
       v = speed(genomes[i], team_comm_);
@@ -45,9 +56,12 @@ std::vector<double> EvaluationTeams::evaluate(const std::vector<Genome>& genomes
       MPI_Abort(world_, 4);
     }
     // Only the team leader contributes, so a team's ranks need not agree bit for bit.
-    if (team_rank_ == 0) local[i] = std::isnan(v) ? kFailed : v;
+    if (team_rank_ == 0) {
+      local[i] = std::isnan(v) ? kFailed : v;
+      if (on_result) on_result(i, local[i]);
+    }
     ++mine;
-    if (on_done && world_rank_ == 0) on_done(std::min<long>(genomes.size(), mine * teams_));
+    if (on_done && world_rank_ == 0) on_done(std::min<long>(pending.size(), mine * teams_));
   }
   // max(-inf, x) = x exactly: every entry ends up as its team leader's value.
   MPI_Allreduce(local.data(), all.data(), static_cast<int>(all.size()), MPI_DOUBLE, MPI_MAX, world_);

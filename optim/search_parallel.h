@@ -4,10 +4,14 @@
 // team i mod teams (round-robin). After a batch every rank holds every speed, in
 // batch order, exactly as the evaluating team computed it (gathered with MPI_MAX
 // over -inf fill: bit-exact), so results do not depend on the rank count.
+// Speeds already known (the saved evaluations of an interrupted step) are passed
+// in and not evaluated again; the remaining genomes are dealt round-robin.
 #pragma once
 #include <mpi.h>
 
+#include <cstddef>
 #include <functional>
+#include <map>
 #include <vector>
 
 #include "optim/fitness.h"
@@ -33,9 +37,14 @@ class EvaluationTeams {
   // with a single team and aborts the MPI job with several (a lone team cannot unwind).
   // `on_done(k)` is called on world rank 0 after each of its own team's evaluations
   // with an estimate of the batch evaluations done so far (for progress lines).
+  // `known[i]` is returned as the speed of genome i without evaluating it; the other
+  // genomes go round-robin to the teams in batch order. `on_result(i, speed)` is called
+  // on each team leader right after its team has evaluated genome i (to save it at once).
   std::vector<double> evaluate(const std::vector<Genome>& genomes,
                                const std::function<double(const Genome&, MPI_Comm)>& speed,
-                               const std::function<void(long)>& on_done = nullptr) const;
+                               const std::function<void(long)>& on_done = nullptr,
+                               const std::map<std::size_t, double>& known = {},
+                               const std::function<void(std::size_t, double)>& on_result = nullptr) const;
 
  private:
   MPI_Comm world_;

@@ -1,8 +1,9 @@
 # Kill-and-resume test of `morphfem search` (ctest search.kill_and_resume_matches_uninterrupted).
 # 1. An uninterrupted run writes WORK/whole.
 # 2. The same run into WORK/killed is killed with SIGKILL twice (mid-generation of the
-#    first experiment's hill climber, then during the second experiment's CMA-ES),
-#    then started again until it finishes.
+#    first experiment's hill climber, then part way through the second experiment's
+#    CMA-ES iteration), then started again until it finishes; that session must reuse
+#    the evaluations saved before the second kill (optim/search_partial.h).
 # 3. Every result file (CSVs, checkpoint.h5, best schedules, validation.csv) must be
 #    byte-for-byte identical to the uninterrupted run's.
 file(REMOVE_RECURSE ${WORK})
@@ -16,14 +17,16 @@ if(NOT rc EQUAL 0)
   message(FATAL_ERROR "uninterrupted run failed (${rc}): ${err}")
 endif()
 
-# start_and_kill.sh CSV LINES DELAY -- command...: starts the command, waits until CSV has
-# at least LINES lines, sleeps DELAY s, sends SIGKILL. Fails if the run ended first.
+# start_and_kill.sh FILE LINES DELAY -- command...: starts the command, waits until FILE has
+# at least LINES lines (LINES = 0: until FILE exists), sleeps DELAY s, sends SIGKILL.
+# Fails if the run ended first.
 file(WRITE ${WORK}/start_and_kill.sh [=[
 csv="$1"; lines="$2"; delay="$3"; shift 4
 "$@" >/dev/null 2>&1 &
 pid=$!
 tries=0
-while [ "$( (wc -l < "$csv") 2>/dev/null || echo 0)" -lt "$lines" ]; do
+count() { if [ "$lines" -eq 0 ]; then [ -e "$csv" ] && echo 0 || echo -1; else (wc -l < "$csv") 2>/dev/null || echo 0; fi; }
+while [ "$(count)" -lt "$lines" ]; do
   tries=$((tries + 1))
   if [ "$tries" -gt 6000 ] || ! kill -0 "$pid" 2>/dev/null; then echo "run ended before the kill point"; exit 1; fi
   sleep 0.01
@@ -46,16 +49,44 @@ list(LENGTH rows n)
 if(n GREATER_EQUAL 14)
   message(FATAL_ERROR "the killed run had already finished the experiment (${n} CSV lines)")
 endif()
-# Kill 2: second experiment, CMA-ES, after its second step (evaluations 0..13 written).
-execute_process(COMMAND sh ${WORK}/start_and_kill.sh ${killed}/hill_semi/cmaes/hill_semi.csv 6 0.05 --
+# Kill 2: second experiment, CMA-ES, part way through its first iteration (one step of
+# 4 x 12 evaluations): 0.3 s after the first of them is saved to partial_team_0.h5.
+execute_process(COMMAND sh ${WORK}/start_and_kill.sh ${killed}/hill_semi/cmaes/partial_team_0.h5 0 0.3 --
                         ${MORPHFEM} ${args} --out ${killed} RESULT_VARIABLE rc OUTPUT_VARIABLE out)
 if(NOT rc EQUAL 0)
   message(FATAL_ERROR "second kill failed: ${out}")
 endif()
 message(STATUS "kill 2: ${out}")
+if(EXISTS ${killed}/hill_semi/cmaes/hill_semi.csv)
+  file(STRINGS ${killed}/hill_semi/cmaes/hill_semi.csv rows)
+  list(LENGTH rows n)
+  if(n GREATER 2)
+    message(FATAL_ERROR "the killed run had already finished the CMA-ES iteration (${n} CSV lines)")
+  endif()
+endif()
 execute_process(COMMAND ${MORPHFEM} ${args} --out ${killed} RESULT_VARIABLE rc OUTPUT_QUIET ERROR_VARIABLE err)
 if(NOT rc EQUAL 0)
   message(FATAL_ERROR "resumed run failed (${rc}): ${err}")
+endif()
+# The resumed session took the saved evaluations of the unfinished iteration instead of redoing them.
+file(READ ${killed}/summary.json json)
+string(JSON n_experiments LENGTH ${json} experiments)
+math(EXPR last "${n_experiments} - 1")
+set(reused -1)
+foreach(i RANGE ${last})
+  string(JSON name GET ${json} experiments ${i} experiment)
+  string(JSON method GET ${json} experiments ${i} method)
+  if(name STREQUAL "hill_semi" AND method STREQUAL "cmaes")
+    string(JSON reused GET ${json} experiments ${i} evaluations_reused)
+    string(JSON timed GET ${json} experiments ${i} evaluations_timed)
+  endif()
+endforeach()
+if(NOT reused GREATER 0)
+  message(FATAL_ERROR "the resumed CMA-ES reused ${reused} saved evaluations, expected some")
+endif()
+message(STATUS "resume reused ${reused} saved evaluations of the unfinished CMA-ES iteration, evaluated ${timed}")
+if(EXISTS ${killed}/hill_semi/cmaes/partial_team_0.h5)
+  message(FATAL_ERROR "partial_team_0.h5 was left behind after the step completed")
 endif()
 
 file(GLOB_RECURSE files RELATIVE ${WORK}/whole ${WORK}/whole/*/*.csv ${WORK}/whole/*/*.h5 ${WORK}/whole/*/*.yaml)
