@@ -43,7 +43,7 @@ const char* kRobotUsage =
     "        --set-physical keys apply to both, --set-physical-round / -flat to one); preset\n"
     "        lattice-mechanics (not by default): the voxel-study preset with the lattice's floor\n"
     "        spheres, bladder stiffness and mass, as a further column (needs order 2)\n"
-    "  ladder --case NAME [--levels 0,1,2] [--out DIR]\n"
+    "  ladder --case NAME [--levels 0,1,2] [--preset voxel|lattice-mechanics] [--out DIR] [--set KEY=VALUE ...]\n"
     "        one case on several fidelity levels: speed against wall time, and the\n"
     "        cheapest level within 5 % of the finest\n"
     "  spread --case NAME --vary KEY=V1,V2,... [--levels 0,...] [--preset voxel|physical]\n"
@@ -547,11 +547,15 @@ int validate(const std::vector<std::string>& args, MPI_Comm comm) {
 }
 
 int ladder(const std::vector<std::string>& args, MPI_Comm comm) {
-  check_options(args, {"--case", "--levels", "--out"});
+  check_options(args, {"--case", "--levels", "--out", "--preset", "--set"});
   const std::string name = option(args, "--case", "");
   if (name.empty()) throw InputError("morphfem robot ladder", "needs --case NAME");
-  const auto all_cases = voxel_baseline_cases(source_dir());
-  const RobotCase& c = find_case(all_cases, name);
+  const std::string preset = option(args, "--preset", "voxel");
+  if (preset != "voxel" && preset != "lattice-mechanics")
+    throw InputError("--preset", "unknown preset '" + preset + "' (known: voxel, lattice-mechanics)");
+  const auto all_cases = preset == "voxel" ? voxel_baseline_cases(source_dir()) : lattice_mechanics_cases(source_dir());
+  RobotCase c = find_case(all_cases, name);
+  for (const auto& assignment : options(args, "--set")) c.overrides.push_back(assignment);  // after the preset's
   const std::string out_dir = option(args, "--out", "results/robot/ladder");
   std::vector<std::pair<RobotCase, RobotFidelity>> jobs;
   for (const auto& l : split(option(args, "--levels", "0,1,2"))) jobs.emplace_back(c, find_robot_fidelity(l));
@@ -579,7 +583,13 @@ int ladder(const std::vector<std::string>& args, MPI_Comm comm) {
               pick.c_str());
   std::filesystem::create_directories(out_dir);
   Json summary;
-  summary.add("case", c.name).add("within_5_percent_of_finest", pick).add("levels", rows);
+  std::string overrides;
+  for (const auto& assignment : options(args, "--set")) overrides += (overrides.empty() ? "" : "; ") + assignment;
+  summary.add("case", c.name)
+      .add("preset", preset)
+      .add("overrides", overrides)
+      .add("within_5_percent_of_finest", pick)
+      .add("levels", rows);
   write_file_atomic(out_dir + "/" + c.name + "_ladder.json", summary.str(true) + "\n");
   return 0;
 }
