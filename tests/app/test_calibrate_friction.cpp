@@ -17,7 +17,7 @@
 #include "app/simulation.h"
 #include "core/errors.h"
 #include "optim/calibration_file.h"
-#include "tests/app/temp_dir.h"
+#include "tests/support/temp_dir.h"
 
 namespace morphfem {
 namespace {

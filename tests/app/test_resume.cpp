@@ -18,7 +18,7 @@
 #include "app/scene.h"
 #include "app/simulation.h"
 #include "core/errors.h"
-#include "tests/app/temp_dir.h"
+#include "tests/support/temp_dir.h"
 
 using namespace morphfem;
 namespace fs = std::filesystem;

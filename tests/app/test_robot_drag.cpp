@@ -14,7 +14,7 @@
 #include "core/errors.h"
 #include "core/test_machine_export.h"
 #include "optim/pull_test.h"
-#include "temp_dir.h"
+#include "tests/support/temp_dir.h"
 
 using namespace morphfem;
 

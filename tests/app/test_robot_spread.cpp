@@ -9,7 +9,7 @@
 
 #include "app/robot_study.h"
 #include "core/errors.h"
-#include "temp_dir.h"
+#include "tests/support/temp_dir.h"
 
 using namespace morphfem;
 

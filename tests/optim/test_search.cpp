@@ -20,6 +20,7 @@
 #include "optim/search_experiment.h"
 #include "optim/search_parallel.h"
 #include "optim/search_stats.h"
+#include "tests/support/temp_dir.h"
 
 namespace morphfem {
 namespace {
@@ -30,16 +31,6 @@ Genome middle_genome() {
   g.core_pressure_pa = 6000;
   for (auto& r : g.rows) r = {4, 4};
   return g;
-}
-
-std::string temp_dir(const std::string& name) {
-  int rank = 0;
-  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
-  const auto dir =
-      std::filesystem::path(MORPHFEM_BINARY_DIR) / "tests" / "optim" / "tmp" / (name + "_" + std::to_string(rank));
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
-  return dir.string();
 }
 
 std::string read_text(const std::string& path) {
@@ -291,7 +282,7 @@ TEST(SearchCheckpoint, StateRoundTripsExactlyThroughHdf5) {
   s.texts["fidelity"] = "";
   s.arrays["history"] = {0.1, -0.0, 1e-300, -std::numeric_limits<double>::infinity(), 0.30000000000000004};
   s.arrays["empty"] = {};
-  const std::string path = temp_dir("checkpoint") + "/state.h5";
+  const std::string path = temp_dir("checkpoint").string() + "/state.h5";
   write_checkpoint(path, s);
   EXPECT_FALSE(std::filesystem::exists(path + ".tmp"));
   const SearchState r = read_checkpoint(path);
@@ -304,7 +295,7 @@ TEST(SearchCheckpoint, StateRoundTripsExactlyThroughHdf5) {
     EXPECT_EQ(r.arrays.at(k), v) << k;
   }
   // Equal states give identical bytes (no time stamps in the file).
-  const std::string again = temp_dir("checkpoint_again") + "/state.h5";
+  const std::string again = temp_dir("checkpoint_again").string() + "/state.h5";
   write_checkpoint(again, s);
   EXPECT_EQ(read_text(path), read_text(again));
   // Not a checkpoint: a located InputError.
@@ -317,7 +308,7 @@ TEST(SearchCheckpoint, RestoredMethodsContinueExactlyAsUninterrupted) {
   SearchSetup setup;
   setup.runs = 3;
   setup.generations = 40;
-  const std::string dir = temp_dir("restore");
+  const std::string dir = temp_dir("restore").string();
   for (const std::string name : {"hill", "cmaes"}) {
     const auto whole = run_method(name, setup, env);
     auto first = make_search_method(name, setup);
@@ -421,7 +412,7 @@ TEST(SearchStats, RankCorrelationsOfSmallExamples) {
 
 TEST(SearchExperiment, HistoryCsvRoundTripsAndReadsTheVoxelStudy) {
   const std::vector<std::vector<double>> h = {{0.1, -0.2}, {0.30000000000000004, 1e-17}};
-  const std::string path = temp_dir("csv") + "/h.csv";
+  const std::string path = temp_dir("csv").string() + "/h.csv";
   std::ofstream(path) << history_csv(h);
   EXPECT_EQ(read_history_csv(path), h);
   EXPECT_EQ(history_csv(h).substr(0, 9), "g,f_1,f_2");
@@ -442,7 +433,7 @@ TEST(SearchExperiment, RunsEndToEndAndExtendsAFinishedRunExactly) {
   o.methods = {"hill", "cmaes"};
   o.climbers = 3;
   o.generations = 8;
-  o.out_dir = temp_dir("experiment");
+  o.out_dir = temp_dir("experiment").string();
   o.progress = false;
   o.validate_fidelity = "exact";
   const SearchReport report = run_search(o, MPI_COMM_SELF);
@@ -482,7 +473,7 @@ TEST(SearchExperiment, RunsEndToEndAndExtendsAFinishedRunExactly) {
   longer.validate_fidelity.clear();
   const SearchReport extended = run_search(longer, MPI_COMM_SELF);
   SearchOptions fresh = longer;
-  fresh.out_dir = temp_dir("experiment_fresh");
+  fresh.out_dir = temp_dir("experiment_fresh").string();
   const SearchReport direct = run_search(fresh, MPI_COMM_SELF);
   for (size_t i = 0; i < extended.results.size(); ++i) {
     EXPECT_TRUE(extended.results[i].resumed);

@@ -15,19 +15,10 @@
 #include "optim/search_experiment.h"
 #include "optim/search_method.h"
 #include "optim/search_partial.h"
+#include "tests/support/temp_dir.h"
 
 namespace morphfem {
 namespace {
-
-std::string temp_dir(const std::string& name) {
-  int rank = 0;
-  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
-  const auto dir =
-      std::filesystem::path(MORPHFEM_BINARY_DIR) / "tests" / "optim" / "tmp" / (name + "_" + std::to_string(rank));
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
-  return dir.string();
-}
 
 SearchOptions cmaes_options(const std::string& dir) {
   SearchOptions o;
@@ -58,7 +49,7 @@ std::vector<Genome> iteration_batch(const SearchOptions& o) {
 }
 
 TEST(SearchPartial, SpeedsRoundTripBitForBitAndOnlyTheirStepAndGenomesAreReused) {
-  const std::string dir = temp_dir("partial_roundtrip");
+  const std::string dir = temp_dir("partial_roundtrip").string();
   const SearchOptions o = cmaes_options(dir);
   const SearchState meta = search_metadata(find_experiment("flat_open"), "cmaes", o);
   const std::vector<Genome> batch = iteration_batch(o);
@@ -89,7 +80,7 @@ TEST(SearchPartial, SpeedsRoundTripBitForBitAndOnlyTheirStepAndGenomesAreReused)
 }
 
 TEST(SearchPartial, FilesOfAnotherSetupOrDisagreeingSpeedsAreRefused) {
-  const std::string dir = temp_dir("partial_refused");
+  const std::string dir = temp_dir("partial_refused").string();
   const SearchOptions o = cmaes_options(dir);
   const SearchState meta = search_metadata(find_experiment("flat_open"), "cmaes", o);
   const std::vector<Genome> batch = iteration_batch(o);
@@ -140,7 +131,7 @@ void run_interrupted(const SearchOptions& o, long at) {
 }
 
 TEST(SearchPartial, AResumedStepReusesTheSavedEvaluationsAndEndsAsUninterrupted) {
-  const SearchOptions whole = interruptible_options(temp_dir("partial_whole"));
+  const SearchOptions whole = interruptible_options(temp_dir("partial_whole").string());
   const SearchReport reference = run_search(whole, MPI_COMM_SELF);
   ASSERT_EQ(reference.results.size(), 1u);
   EXPECT_EQ(reference.results[0].evaluations_timed, 27);
@@ -149,7 +140,7 @@ TEST(SearchPartial, AResumedStepReusesTheSavedEvaluationsAndEndsAsUninterrupted)
 
   // Interrupted in step 1 after its evaluations 0..9 (step 0 has the 3 random starts):
   // step 0's checkpoint and the 10 saved speeds are on disk.
-  const SearchOptions resumed = interruptible_options(temp_dir("partial_resumed"));
+  const SearchOptions resumed = interruptible_options(temp_dir("partial_resumed").string());
   const std::string dir = resumed.out_dir + "/flat_open/cmaes";
   run_interrupted(resumed, 3 + 10);
   ASSERT_TRUE(std::filesystem::exists(dir + "/checkpoint.h5"));
@@ -168,7 +159,7 @@ TEST(SearchPartial, AResumedStepReusesTheSavedEvaluationsAndEndsAsUninterrupted)
   EXPECT_FALSE(std::filesystem::exists(partial_step_path(dir, 0)));
 
   // A saved speed is taken as it is, not recomputed: a planted value shows up as a best.
-  const SearchOptions planted = interruptible_options(temp_dir("partial_planted"));
+  const SearchOptions planted = interruptible_options(temp_dir("partial_planted").string());
   const std::string planted_dir = planted.out_dir + "/flat_open/cmaes";
   run_interrupted(planted, 3 + 4);
   const std::vector<Genome> batch = iteration_batch(planted);
