@@ -33,8 +33,8 @@ namespace morphfem {
 namespace {
 
 const char* kSpreadUsage =
-    "usage: morphfem robot spread --case NAME --vary KEY=V1,V2,... [--levels 0,...] [--preset voxel|physical]\n"
-    "                             [--out DIR] [--set KEY=VALUE ...]\n";
+    "usage: morphfem robot spread --case NAME --vary KEY=V1,V2,... [--levels 0,...]\n"
+    "                             [--preset voxel|lattice-mechanics|physical] [--out DIR] [--set KEY=VALUE ...]\n";
 
 }  // namespace
 
@@ -76,6 +76,23 @@ SpreadStats spread_stats(const std::vector<CaseOutcome>& runs) {
   return s;
 }
 
+std::vector<std::pair<RobotCase, RobotFidelity>> spread_jobs(const RobotCase& base,
+                                                             const std::vector<std::string>& sets,
+                                                             const std::string& key,
+                                                             const std::vector<std::string>& values,
+                                                             const std::vector<RobotFidelity>& levels) {
+  std::vector<std::pair<RobotCase, RobotFidelity>> jobs;
+  for (const auto& level : levels)
+    for (size_t k = 0; k < values.size(); ++k) {
+      RobotCase c = base;  // its own folder, CASE_vK_L<level>
+      c.name = base.name + "_v" + std::to_string(k);
+      c.overrides.insert(c.overrides.end(), sets.begin(), sets.end());
+      c.overrides.push_back(key + "=" + values[k]);
+      jobs.emplace_back(c, level);
+    }
+  return jobs;
+}
+
 int robot_spread(const std::vector<std::string>& args, MPI_Comm comm) {
   check_options(args, {"--case", "--vary", "--levels", "--preset", "--out", "--set"});
   const std::string name = option(args, "--case", "");
@@ -85,11 +102,12 @@ int robot_spread(const std::vector<std::string>& args, MPI_Comm comm) {
                      std::string("needs --case NAME and --vary KEY=V1,V2,...\n") + kSpreadUsage);
   const auto [key, values] = parse_variation(spec);
   const std::string preset = option(args, "--preset", "voxel");
-  if (preset != "voxel" && preset != "physical")
-    throw InputError("--preset", "unknown preset '" + preset + "' (known: voxel, physical)");
+  if (preset != "voxel" && preset != "lattice-mechanics" && preset != "physical")
+    throw InputError("--preset", "unknown preset '" + preset + "' (known: voxel, lattice-mechanics, physical)");
   const bool physical = preset == "physical";
-  const auto cases =
-      physical ? physical_baseline_cases(MORPHFEM_SOURCE_DIR) : voxel_baseline_cases(MORPHFEM_SOURCE_DIR);
+  const auto cases = physical                        ? physical_baseline_cases(MORPHFEM_SOURCE_DIR)
+                     : preset == "lattice-mechanics" ? lattice_mechanics_cases(MORPHFEM_SOURCE_DIR)
+                                                     : voxel_baseline_cases(MORPHFEM_SOURCE_DIR);
   const RobotCase& base = find_case(cases, name);
   std::vector<RobotFidelity> levels;
   if (physical) {
@@ -106,16 +124,7 @@ int robot_spread(const std::vector<std::string>& args, MPI_Comm comm) {
   }
   const std::string out_dir = option(args, "--out", "results/robot/spread_" + name);
 
-  // Job (level l, value k): the case with --set keys, then KEY=V_k; its own folder.
-  std::vector<std::pair<RobotCase, RobotFidelity>> jobs;
-  for (const auto& level : levels)
-    for (size_t k = 0; k < values.size(); ++k) {
-      RobotCase c = base;
-      c.name = base.name + "_v" + std::to_string(k);
-      c.overrides = options(args, "--set");
-      c.overrides.push_back(key + "=" + values[k]);
-      jobs.emplace_back(c, level);
-    }
+  const auto jobs = spread_jobs(base, options(args, "--set"), key, values, levels);
   const std::vector<CaseOutcome> outcomes = run_robot_jobs(jobs, out_dir, comm);
   int rank = 0;
   MPI_Comm_rank(comm, &rank);

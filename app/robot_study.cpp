@@ -46,7 +46,7 @@ const char* kRobotUsage =
     "  ladder --case NAME [--levels 0,1,2] [--preset voxel|lattice-mechanics] [--out DIR] [--set KEY=VALUE ...]\n"
     "        one case on several fidelity levels: speed against wall time, and the\n"
     "        cheapest level within 5 % of the finest\n"
-    "  spread --case NAME --vary KEY=V1,V2,... [--levels 0,...] [--preset voxel|physical]\n"
+    "  spread --case NAME --vary KEY=V1,V2,... [--levels 0,...] [--preset voxel|lattice-mechanics|physical]\n"
     "         [--out DIR] [--set KEY=VALUE ...]\n"
     "        one case run once per value of one scene key (a perturbation ensemble, e.g.\n"
     "        --vary environment.heading_deg=-1,-0.5,0,0.5,1), on each level: every speed, their\n"

@@ -159,6 +159,13 @@ int robot_friction_drag(const std::vector<std::string>& args, MPI_Comm comm);
 // run sets KEY=V). InputError if it is not KEY=..., has fewer than two values, or
 // repeats a value.
 std::pair<std::string, std::vector<std::string>> parse_variation(const std::string& spec);
+// The runs of `robot spread`, level by level, value by value: `base` named CASE_vK
+// with its own keys (a preset's), then `sets` (--set), then KEY=V_k.
+std::vector<std::pair<RobotCase, RobotFidelity>> spread_jobs(const RobotCase& base,
+                                                             const std::vector<std::string>& sets,
+                                                             const std::string& key,
+                                                             const std::vector<std::string>& values,
+                                                             const std::vector<RobotFidelity>& levels);
 // The speeds of an ensemble of runs: n completed (failed ones left out), mean, sample
 // standard deviation sqrt(sum (v - mean)^2 / (n - 1)) (NaN for n < 2), median (the
 // middle value, or the mean of the two middle ones: robust to one run that tumbles

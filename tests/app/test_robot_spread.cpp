@@ -4,6 +4,7 @@
 #include <petscsys.h>
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 
@@ -64,14 +65,33 @@ TEST(RobotSpread, BadCommandLinesAreRefused) {
   EXPECT_THROW(
       robot_spread({"spread", "--case", "no_such_case", "--vary", "solver.max_step=0.1,0.05"}, PETSC_COMM_WORLD),
       InputError);
-  EXPECT_THROW(
-      robot_spread({"spread", "--case", "roll_flat", "--vary", "solver.max_step=0.1,0.05", "--preset", "lattice"},
-                   PETSC_COMM_WORLD),
-      InputError);
+  EXPECT_THROW(robot_spread({"spread", "--case", "roll_flat", "--vary", "solver.max_step=0.1,0.05", "--preset",
+                             "lattice"},  // not a preset's name
+                            PETSC_COMM_WORLD),
+               InputError);
   EXPECT_THROW(robot_spread({"spread", "--case", "roll_flat", "--vary", "solver.max_step=0.1,0.05", "--preset",
                              "physical", "--levels", "0"},
                             PETSC_COMM_WORLD),
                InputError);
+}
+
+// A lattice-mechanics ensemble keeps the preset's keys, then the --set keys, then the varied value.
+TEST(RobotSpread, JobsKeepThePresetsKeysBeforeTheSetAndVariedOnes) {
+  const RobotCase base = find_case(lattice_mechanics_cases(MORPHFEM_SOURCE_DIR), "roll_hill15");
+  const std::vector<RobotFidelity> levels = {find_robot_fidelity("0.02:2:0.05"), find_robot_fidelity("0")};
+  const auto jobs = spread_jobs(base, {"solver.max_step=0.04"}, "environment.heading_deg", {"-1", "1"}, levels);
+  ASSERT_EQ(jobs.size(), 4u);
+  const auto preset = lattice_mechanics_overrides();
+  for (size_t j = 0; j < jobs.size(); ++j) {
+    const RobotCase& c = jobs[j].first;
+    EXPECT_EQ(c.name, "roll_hill15_v" + std::to_string(j % 2));
+    EXPECT_TRUE(c.lattice_mechanics);
+    ASSERT_EQ(c.overrides.size(), preset.size() + 2);
+    EXPECT_TRUE(std::equal(preset.begin(), preset.end(), c.overrides.begin()));
+    EXPECT_EQ(c.overrides[preset.size()], "solver.max_step=0.04");
+    EXPECT_EQ(c.overrides.back(), std::string("environment.heading_deg=") + (j % 2 ? "1" : "-1"));
+    EXPECT_EQ(jobs[j].second.name, levels[j / 2].name);
+  }
 }
 
 // The cheapest case (empty schedule, flat, level 0, about 20 s a run) with the largest
