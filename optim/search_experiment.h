@@ -1,5 +1,5 @@
 // The study's search experiments and the loop that runs them: climbers spread over
-// MPI ranks, a checkpoint after every step and every evaluation saved as it
+// MPI ranks, a checkpoint after every step and each of its evaluations saved as it
 // finishes, resume from both, results in
 // the voxel study's layout, re-evaluation at a validation fidelity, and the
 // summary table beside the voxel study's numbers.
