@@ -189,11 +189,14 @@ ExperimentResult SearchRunner::run(const ExperimentSpec& spec, const std::string
   progress.set_resumed_from(resumed_evaluations);
   const long evaluations_before = evaluations_;
   const double wall_before = wall_s_;
+  // After a step: its checkpoint, then (the checkpoint holds the whole step) its saved
+  // evaluations are removed, then the CSV. A CSV row thus means no partial file of that step is left.
   auto save = [&]() {
     state = meta;
     method->save(state);
     if (root_) {
       write_checkpoint(checkpoint, state);
+      remove_partial_steps(r.dir);
       write_file_atomic(r.csv, history_csv(method->history()));
     }
   };
@@ -236,8 +239,7 @@ ExperimentResult SearchRunner::run(const ExperimentSpec& spec, const std::string
     const std::vector<double> speeds = evaluate(genomes, spec.env, o_.fidelity, on_done, partial.speeds, on_result);
     method->accept(speeds);
     save();
-    if (root_) remove_partial_steps(r.dir);  // the checkpoint now holds the whole step
-    MPI_Barrier(teams_.world());             // before any rank looks for the next step's files
+    MPI_Barrier(teams_.world());  // the step's partial files are gone before any rank looks for the next step's
   }
   progress.finish("best " + fixed(max_of(method->best_speeds())) + " BL/s");
   r.evaluations_timed = evaluations_ - evaluations_before;

@@ -17,16 +17,15 @@ if(NOT rc EQUAL 0)
   message(FATAL_ERROR "uninterrupted run failed (${rc}): ${err}")
 endif()
 
-# start_and_kill.sh FILE LINES DELAY -- command...: starts the command, waits until FILE has
-# at least LINES lines (LINES = 0: until FILE exists), sleeps DELAY s, sends SIGKILL.
-# Fails if the run ended first.
+# start_and_kill.sh CSV LINES DELAY EXTRA -- command...: starts the command, waits until CSV
+# has at least LINES lines and (unless EXTRA is -) the file EXTRA exists, sleeps DELAY s,
+# sends SIGKILL. Fails if the run ended first.
 file(WRITE ${WORK}/start_and_kill.sh [=[
-csv="$1"; lines="$2"; delay="$3"; shift 4
+csv="$1"; lines="$2"; delay="$3"; extra="$4"; shift 5
 "$@" >/dev/null 2>&1 &
 pid=$!
 tries=0
-count() { if [ "$lines" -eq 0 ]; then [ -e "$csv" ] && echo 0 || echo -1; else (wc -l < "$csv") 2>/dev/null || echo 0; fi; }
-while [ "$(count)" -lt "$lines" ]; do
+while [ "$( (wc -l < "$csv") 2>/dev/null || echo 0)" -lt "$lines" ] || { [ "$extra" != - ] && [ ! -e "$extra" ]; }; do
   tries=$((tries + 1))
   if [ "$tries" -gt 6000 ] || ! kill -0 "$pid" 2>/dev/null; then echo "run ended before the kill point"; exit 1; fi
   sleep 0.01
@@ -38,7 +37,7 @@ echo "killed with status $?"
 ]=])
 set(killed ${WORK}/killed)
 # Kill 1: first experiment, hill climber, when generation 3 is written (CSV header + g = 0..3), 80 ms later.
-execute_process(COMMAND sh ${WORK}/start_and_kill.sh ${killed}/flat_open/hill/flat_open.csv 5 0.08 --
+execute_process(COMMAND sh ${WORK}/start_and_kill.sh ${killed}/flat_open/hill/flat_open.csv 5 0.08 - --
                         ${MORPHFEM} ${args} --out ${killed} RESULT_VARIABLE rc OUTPUT_VARIABLE out)
 if(NOT rc EQUAL 0)
   message(FATAL_ERROR "first kill failed: ${out}")
@@ -49,9 +48,11 @@ list(LENGTH rows n)
 if(n GREATER_EQUAL 14)
   message(FATAL_ERROR "the killed run had already finished the experiment (${n} CSV lines)")
 endif()
-# Kill 2: second experiment, CMA-ES, part way through its first iteration (one step of
-# 4 x 12 evaluations): 0.3 s after the first of them is saved to partial_team_0.h5.
-execute_process(COMMAND sh ${WORK}/start_and_kill.sh ${killed}/hill_semi/cmaes/partial_team_0.h5 0 0.3 --
+# Kill 2: second experiment, CMA-ES, part way through its first iteration (step 1, 4 x 12
+# evaluations, about 2 s): once step 0 is in the CSV (header + g = 0) and an evaluation of
+# step 1 is saved in partial_team_0.h5 (step 0's file is removed before its CSV row is written).
+execute_process(COMMAND sh ${WORK}/start_and_kill.sh ${killed}/hill_semi/cmaes/hill_semi.csv 2 0.1
+                        ${killed}/hill_semi/cmaes/partial_team_0.h5 --
                         ${MORPHFEM} ${args} --out ${killed} RESULT_VARIABLE rc OUTPUT_VARIABLE out)
 if(NOT rc EQUAL 0)
   message(FATAL_ERROR "second kill failed: ${out}")
