@@ -321,17 +321,12 @@ SimulationResult run_robot_case(const RobotCase& c, const RobotFidelity& level, 
   Scene scene = scene_from_yaml(doc, c.template_scene);
   RunOptions options{!output_dir.empty(), progress};
   options.scene_text = scene_identity(doc);  // so that `morphfem run DIR/scene.yaml --resume` can extend it
-  SimulationResult r = run_scene(scene, comm, options);
-  int rank = 0;
-  MPI_Comm_rank(comm, &rank);
-  if (rank == 0 && !r.output_dir.empty()) {
-    YAML::Emitter out;
-    out << doc;
-    write_file_atomic(r.output_dir + "/scene.yaml", "# morphfem robot case '" + c.name + "', fidelity " + level.name +
-                                                        " (template " + c.template_scene +
-                                                        "); run it with morphfem run\n" + out.c_str() + "\n");
-  }
-  return r;
+  // Saved when the run starts: a killed case resumes with `morphfem run DIR.partial/scene.yaml --resume`.
+  YAML::Emitter out;
+  out << doc;
+  options.scene_file = "# morphfem robot case '" + c.name + "', fidelity " + level.name + " (template " +
+                       c.template_scene + "); run it with morphfem run\n" + out.c_str() + "\n";
+  return run_scene(scene, comm, options);
 }
 
 double robot_speed(const Genome& genome, double slope_deg, const std::string& fidelity, MPI_Comm comm) {

@@ -530,6 +530,7 @@ SimulationResult run_scene(const Scene& scene, MPI_Comm comm, const RunOptions& 
       tmp_dir = temporary_output_dir(scene.output_dir);
       writer = std::make_unique<ResultWriter>(tmp_dir, scene.name, mesh);
     }
+    if (!options.scene_file.empty()) write_file_atomic(tmp_dir + "/scene.yaml", options.scene_file);
   }
   std::vector<std::string> cavity_columns{"time"};
   for (const auto& c : cavities) {

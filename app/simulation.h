@@ -51,6 +51,10 @@ struct RunOptions {
   // checkpoint of another scene is refused.
   bool resume = false;
   std::string scene_text;
+  // If not empty: written as OUTPUT.partial/scene.yaml when the run starts (so it ends
+  // up in OUTPUT), for a scene built in memory (robot cases): an interrupted run then
+  // resumes with `morphfem run OUTPUT.partial/scene.yaml --resume`.
+  std::string scene_file;
   // Test hook: after this many steps of this process, save a checkpoint and stop
   // as a killed run would (the output stays in OUTPUT.partial); 0: no stop.
   int stop_after_steps = 0;

@@ -259,3 +259,33 @@ TEST(RobotStudy, SavedCaseSceneResumesItsRun) {
   EXPECT_NEAR(extended.resumed_at, 0.1, 1e-9);
   std::filesystem::remove_all(dir);
 }
+
+// A killed case leaves its scene beside its checkpoint (OUTPUT.partial/scene.yaml,
+// written when the run starts), and that file resumes it.
+TEST(RobotStudy, InterruptedCaseResumesFromThePartialScene) {
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("morphfem_case_partial_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  RobotCase c = baseline("empty_0deg_0kPa_flat");
+  c.overrides = {"solver.end_time=0.1"};
+  const YAML::Node doc = robot_scene_yaml(c, find_robot_fidelity("0"), (dir / c.name).string());
+  YAML::Emitter out;
+  out << doc;
+  RunOptions options{true, false};
+  options.scene_text = scene_identity(doc);
+  options.scene_file = std::string(out.c_str()) + "\n";
+  options.stop_after_steps = 2;  // as a kill would: the output stays in OUTPUT.partial
+  const SimulationResult killed = run_scene(scene_from_yaml(doc, c.template_scene), PETSC_COMM_WORLD, options);
+  ASSERT_FALSE(killed.stats.completed);
+  const std::string saved = (dir / (c.name + ".partial") / "scene.yaml").string();
+  ASSERT_TRUE(std::filesystem::exists(saved));
+  const YAML::Node again = load_scene_yaml(saved);
+  RunOptions resume{true, false};
+  resume.resume = true;
+  resume.scene_text = scene_identity(again);
+  const SimulationResult finished = run_scene(scene_from_yaml(again, saved), PETSC_COMM_WORLD, resume);
+  EXPECT_TRUE(finished.stats.completed) << finished.stats.failure;
+  EXPECT_GT(finished.resumed_at, 0.0);
+  EXPECT_TRUE(std::filesystem::exists(dir / c.name / "scene.yaml"));  // moved with the finished output
+  std::filesystem::remove_all(dir);
+}
