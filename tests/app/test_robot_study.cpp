@@ -2,7 +2,6 @@
 // cases of the voxel study, inline schedules, and one cheap run that must not drift.
 #include <gtest/gtest.h>
 #include <petscsys.h>
-#include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
@@ -13,6 +12,7 @@
 #include "app/scene.h"
 #include "app/simulation.h"
 #include "core/errors.h"
+#include "tests/support/temp_dir.h"
 
 using namespace morphfem;
 
@@ -240,9 +240,7 @@ TEST(RobotStudy, EmptyScheduleOnFlatGroundStaysPut) {
 // --set solver.end_time=LATER` finds the checkpoint's scene identical (the case run
 // records its scene like `morphfem run` does).
 TEST(RobotStudy, SavedCaseSceneResumesItsRun) {
-  const std::filesystem::path dir =
-      std::filesystem::temp_directory_path() / ("morphfem_case_resume_" + std::to_string(::getpid()));
-  std::filesystem::remove_all(dir);
+  const std::filesystem::path dir = temp_dir("case_resume");
   RobotCase c = baseline("empty_0deg_0kPa_flat");
   c.overrides = {"solver.end_time=0.1"};
   const SimulationResult first = run_robot_case(c, find_robot_fidelity("0"), dir.string(), PETSC_COMM_WORLD, false);
@@ -263,9 +261,7 @@ TEST(RobotStudy, SavedCaseSceneResumesItsRun) {
 // A killed case leaves its scene beside its checkpoint (OUTPUT.partial/scene.yaml,
 // written when the run starts), and that file resumes it.
 TEST(RobotStudy, InterruptedCaseResumesFromThePartialScene) {
-  const std::filesystem::path dir =
-      std::filesystem::temp_directory_path() / ("morphfem_case_partial_" + std::to_string(::getpid()));
-  std::filesystem::remove_all(dir);
+  const std::filesystem::path dir = temp_dir("case_partial");
   RobotCase c = baseline("empty_0deg_0kPa_flat");
   c.overrides = {"solver.end_time=0.1"};
   const YAML::Node doc = robot_scene_yaml(c, find_robot_fidelity("0"), (dir / c.name).string());
