@@ -102,12 +102,8 @@ int robot_spread(const std::vector<std::string>& args, MPI_Comm comm) {
                      std::string("needs --case NAME and --vary KEY=V1,V2,...\n") + kSpreadUsage);
   const auto [key, values] = parse_variation(spec);
   const std::string preset = option(args, "--preset", "voxel");
-  if (preset != "voxel" && preset != "lattice-mechanics" && preset != "physical")
-    throw InputError("--preset", "unknown preset '" + preset + "' (known: voxel, lattice-mechanics, physical)");
   const bool physical = preset == "physical";
-  const auto cases = physical                        ? physical_baseline_cases(MORPHFEM_SOURCE_DIR)
-                     : preset == "lattice-mechanics" ? lattice_mechanics_cases(MORPHFEM_SOURCE_DIR)
-                                                     : voxel_baseline_cases(MORPHFEM_SOURCE_DIR);
+  const auto cases = preset_cases(preset, {"voxel", "lattice-mechanics", "physical"});
   const RobotCase& base = find_case(cases, name);
   std::vector<RobotFidelity> levels;
   if (physical) {
@@ -203,12 +199,10 @@ int robot_spread(const std::vector<std::string>& args, MPI_Comm comm) {
                 pick.c_str());
   std::filesystem::create_directories(out_dir);
   Json summary;
-  std::string overrides;
-  for (const auto& assignment : options(args, "--set")) overrides += (overrides.empty() ? "" : "; ") + assignment;
   summary.add("case", name)
       .add("preset", preset)
       .add("varied_key", key)
-      .add("overrides", overrides)
+      .add("overrides", joined_options(args, "--set"))
       .add("within_5_percent_of_finest", pick)
       .add("levels", level_rows);
   const std::string json = out_dir + "/" + name + "_spread.json";

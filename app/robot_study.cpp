@@ -87,6 +87,23 @@ std::vector<std::string> options(const std::vector<std::string>& args, const std
   return out;
 }
 
+std::string joined_options(const std::vector<std::string>& args, const std::string& name) {
+  std::string out;
+  for (const auto& value : options(args, name)) out += (out.empty() ? "" : "; ") + value;
+  return out;
+}
+
+std::vector<RobotCase> preset_cases(const std::string& preset, const std::vector<std::string>& allowed) {
+  if (std::find(allowed.begin(), allowed.end(), preset) == allowed.end()) {
+    std::string known;
+    for (const auto& a : allowed) known += (known.empty() ? "" : ", ") + a;
+    throw InputError("--preset", "unknown preset '" + preset + "' (known: " + known + ")");
+  }
+  if (preset == "physical") return physical_baseline_cases(source_dir());
+  if (preset == "lattice-mechanics") return lattice_mechanics_cases(source_dir());
+  return voxel_baseline_cases(source_dir());
+}
+
 std::vector<std::string> split(const std::string& list) {
   std::vector<std::string> out;
   std::stringstream s(list);
@@ -522,8 +539,7 @@ int validate(const std::vector<std::string>& args, MPI_Comm comm) {
               level.max_step, table.c_str());
   std::filesystem::create_directories(out_dir);
   Json summary;
-  std::string overrides;  // the --set assignments, as given
-  for (const auto& assignment : options(args, "--set")) overrides += (overrides.empty() ? "" : "; ") + assignment;
+  const std::string overrides = joined_options(args, "--set");  // the --set assignments, as given
   std::string physical_overrides;
   for (const char* flag : {"--set-physical", "--set-physical-round", "--set-physical-flat"})
     for (const auto& assignment : options(args, flag))
@@ -546,10 +562,7 @@ int ladder(const std::vector<std::string>& args, MPI_Comm comm) {
   const std::string name = option(args, "--case", "");
   if (name.empty()) throw InputError("morphfem robot ladder", "needs --case NAME");
   const std::string preset = option(args, "--preset", "voxel");
-  if (preset != "voxel" && preset != "lattice-mechanics")
-    throw InputError("--preset", "unknown preset '" + preset + "' (known: voxel, lattice-mechanics)");
-  const auto all_cases = preset == "voxel" ? voxel_baseline_cases(source_dir()) : lattice_mechanics_cases(source_dir());
-  RobotCase c = find_case(all_cases, name);
+  RobotCase c = find_case(preset_cases(preset, {"voxel", "lattice-mechanics"}), name);
   for (const auto& assignment : options(args, "--set")) c.overrides.push_back(assignment);  // after the preset's
   const std::string out_dir = option(args, "--out", "results/robot/ladder");
   std::vector<std::pair<RobotCase, RobotFidelity>> jobs;
@@ -578,11 +591,9 @@ int ladder(const std::vector<std::string>& args, MPI_Comm comm) {
               pick.c_str());
   std::filesystem::create_directories(out_dir);
   Json summary;
-  std::string overrides;
-  for (const auto& assignment : options(args, "--set")) overrides += (overrides.empty() ? "" : "; ") + assignment;
   summary.add("case", c.name)
       .add("preset", preset)
-      .add("overrides", overrides)
+      .add("overrides", joined_options(args, "--set"))
       .add("within_5_percent_of_finest", pick)
       .add("levels", rows);
   write_file_atomic(out_dir + "/" + c.name + "_ladder.json", summary.str(true) + "\n");

@@ -150,6 +150,11 @@ Json outcome_json(const RobotCase& c, const RobotFidelity& level, const CaseOutc
 std::string option(const std::vector<std::string>& args, const std::string& name, const std::string& fallback);
 std::vector<std::string> options(const std::vector<std::string>& args, const std::string& name);
 std::vector<std::string> split(const std::string& list);
+// Every value of a repeatable option joined by "; " (for summaries).
+std::string joined_options(const std::vector<std::string>& args, const std::string& name);
+// The eight baseline cases of a preset ("voxel", "lattice-mechanics", "physical"; the
+// physical preset has fewer); InputError naming `allowed` if `preset` is not in it.
+std::vector<RobotCase> preset_cases(const std::string& preset, const std::vector<std::string>& allowed);
 void check_options(const std::vector<std::string>& args, const std::vector<std::string>& allowed);
 
 // `morphfem robot friction-drag` (app/robot_drag.cpp): the pull test on a robot scene.

@@ -11,7 +11,16 @@
 namespace morphfem {
 
 namespace {
-const std::regex kPartialName(R"(partial_team_\d+\.h5)");
+// Every partial file in `dir`, sorted (the same order on every rank).
+std::vector<std::string> partial_files(const std::string& dir) {
+  static const std::regex name(R"(partial_team_\d+\.h5)");
+  std::vector<std::string> files;
+  if (!std::filesystem::is_directory(dir)) return files;
+  for (const auto& entry : std::filesystem::directory_iterator(dir))
+    if (std::regex_match(entry.path().filename().string(), name)) files.push_back(entry.path().string());
+  std::sort(files.begin(), files.end());
+  return files;
+}
 }  // namespace
 
 std::string partial_step_path(const std::string& dir, int team) {
@@ -40,10 +49,7 @@ void write_partial_step(const std::string& path, const SearchState& meta, long s
 PartialSteps read_partial_steps(const std::string& dir, const SearchState& meta, long step,
                                 const std::vector<Genome>& batch) {
   PartialSteps out;
-  if (!std::filesystem::is_directory(dir)) return out;
-  for (const auto& entry : std::filesystem::directory_iterator(dir))
-    if (std::regex_match(entry.path().filename().string(), kPartialName)) out.files.push_back(entry.path().string());
-  std::sort(out.files.begin(), out.files.end());  // the same order on every rank
+  out.files = partial_files(dir);
   for (const auto& path : out.files) {
     const SearchState s = read_state_file(path);
     check_metadata(s, meta, path);
@@ -78,11 +84,7 @@ PartialSteps read_partial_steps(const std::string& dir, const SearchState& meta,
 }
 
 void remove_partial_steps(const std::string& dir) {
-  if (!std::filesystem::is_directory(dir)) return;
-  std::vector<std::filesystem::path> found;
-  for (const auto& entry : std::filesystem::directory_iterator(dir))
-    if (std::regex_match(entry.path().filename().string(), kPartialName)) found.push_back(entry.path());
-  for (const auto& p : found) std::filesystem::remove(p);
+  for (const auto& path : partial_files(dir)) std::filesystem::remove(path);
 }
 
 }  // namespace morphfem
