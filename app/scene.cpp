@@ -2,6 +2,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <optional>
@@ -206,11 +207,14 @@ Scene scene_from_yaml(const YAML::Node& root, const std::string& path) {
     positive("max_step", scene.solver.dt_max);
     positive("rtol", scene.solver.rtol);
     // A choice of two names, or a positive integer.
-    const auto either = [&](const char* key, std::string& out, const std::string& a, const std::string& b) {
+    const auto one_of = [&](const char* key, std::string& out, const std::vector<std::string>& allowed) {
       if (!s[key]) return;
       const std::string where = std::string("solver.") + key;
       out = r.text(s[key], where);
-      if (out != a && out != b) r.fail(s[key], where, "must be '" + a + "' or '" + b + "'");
+      if (std::find(allowed.begin(), allowed.end(), out) != allowed.end()) return;
+      std::string list;
+      for (const auto& a : allowed) list += (list.empty() ? "'" : ", '") + a + "'";
+      r.fail(s[key], where, "must be one of " + list);
     };
     const auto positive_integer = [&](const char* key, int& out) {
       if (!s[key]) return;
@@ -219,9 +223,9 @@ Scene scene_from_yaml(const YAML::Node& root, const std::string& path) {
       if (q < 1 || q != int(q)) r.fail(s[key], where, "must be a positive integer");
       out = int(q);
     };
-    either("linear_solver", scene.solver.linear_solver, "mumps", "gamg");
+    one_of("linear_solver", scene.solver.linear_solver, {"mumps", "mumps_lu", "gamg"});
     std::string projection = "adaptive";
-    either("hessian_projection", projection, "adaptive", "always");
+    one_of("hessian_projection", projection, {"adaptive", "always"});
     scene.solver.hessian_projection = projection == "always" ? HessianProjection::always : HessianProjection::adaptive;
     positive_integer("max_newton_its", scene.solver.max_newton_its);
     positive_integer("easy_newton_its", scene.solver.easy_newton_its);

@@ -54,6 +54,10 @@ Mat Assembler::create_matrix() const {
   PETSC_CHECK(MatSetPreallocationCOO(m, static_cast<PetscCount>(i.size()), i.data(), j.data()));
   PETSC_CHECK(MatSetOption(m, MAT_ROW_ORIENTED, PETSC_FALSE));  // Eigen is column-major
   PETSC_CHECK(MatSetOption(m, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE));
+  // Every term is an energy, so its Hessian, and the sum, is symmetric (projected or
+  // not): the solver's LDL^T factorisation relies on it.
+  PETSC_CHECK(MatSetOption(m, MAT_SYMMETRIC, PETSC_TRUE));
+  PETSC_CHECK(MatSetOption(m, MAT_SYMMETRY_ETERNAL, PETSC_TRUE));
   return m;
 }
 

@@ -5,7 +5,8 @@
 // decreases the energy. Steps adapt: a failed solve is cut and retried from the
 // last converged state, easy solves grow the step.
 //
-// Linear solver: MUMPS LU by default; "gamg" selects CG + GAMG with the rigid-body
+// Linear solver: MUMPS LDL^T by default (the Hessian is symmetric, possibly
+// indefinite); "mumps_lu" selects MUMPS LU, "gamg" CG + GAMG with the rigid-body
 // near-nullspace. Any PETSc option (-snes_*, -ksp_*, -pc_*) on the command line
 // overrides these defaults.
 #pragma once
@@ -44,7 +45,7 @@ struct SolverOptions {
   int max_outer_updates = 20;           // re-solves a step while a term's update_after_solve asks
   double rtol = 1e-9;                   // ||r|| <= rtol ||r_0|| ...
   double atol_factor = 1e-11;           // ... or ||r|| <= atol_factor * (largest ||r_0|| seen)
-  std::string linear_solver = "mumps";  // "mumps" | "gamg"
+  std::string linear_solver = "mumps";  // "mumps" (LDL^T) | "mumps_lu" | "gamg"
   // always: terms that project their Hessian to PSD (EnergyTerm::set_exact_hessian)
   // always do. adaptive: the first iteration of a solve and every one after a
   // damped (backtracked or CCD-bounded) step are projected; after a full Newton step

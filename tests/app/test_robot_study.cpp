@@ -285,3 +285,28 @@ TEST(RobotStudy, InterruptedCaseResumesFromThePartialScene) {
   EXPECT_TRUE(std::filesystem::exists(dir / c.name / "scene.yaml"));  // moved with the finished output
   std::filesystem::remove_all(dir);
 }
+
+// Every term is an energy, so the assembled Hessian is symmetric and the default
+// factorisation, MUMPS's LDL^T, must take LU's Newton iterates: checked on a case with
+// every kind of term the gaits use (elasticity, grown bladders, inertia, damping,
+// gravity, the lattice's floor spheres with friction and switching feet), through
+// the settle and into the first column of the gait (it starts at 1.5 s). A term with
+// an unsymmetric Hessian would make the two differ: LDL^T reads one triangle.
+TEST(RobotStudy, SymmetricFactorisationTakesLusNewtonIterates) {
+  RobotCase c = find_case(lattice_mechanics_cases(MORPHFEM_SOURCE_DIR), "inch_flat");
+  c.overrides = {"solver.end_time=1.8"};
+  const RobotFidelity level = find_robot_fidelity("0.02:1:0.05");
+  std::vector<SimulationResult> runs;
+  for (const char* solver : {"mumps", "mumps_lu"}) {
+    RobotCase with = c;
+    with.overrides.push_back(std::string("solver.linear_solver=") + solver);
+    runs.push_back(run_robot_case(with, level, "", PETSC_COMM_WORLD, false));
+    ASSERT_TRUE(runs.back().stats.completed) << solver << ": " << runs.back().stats.failure;
+  }
+  EXPECT_EQ(runs[0].stats.steps, runs[1].stats.steps);
+  EXPECT_EQ(runs[0].stats.newton_its, runs[1].stats.newton_its);
+  EXPECT_GT(runs[0].stats.newton_its, runs[0].stats.steps);  // the steps were solved, not skipped
+  const double scale = runs[1].u.cwiseAbs().maxCoeff();
+  EXPECT_GT(scale, 1e-3);  // the body settled and started to move
+  EXPECT_LT((runs[0].u - runs[1].u).cwiseAbs().maxCoeff(), 1e-9 * scale);
+}

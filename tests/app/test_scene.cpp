@@ -109,7 +109,10 @@ TEST(Scene, BadSolverChoicesNameTheKeyAndTheAllowedValues) {
   std::string e = error_of(replace(kGood, "solver: {end_time: 1", "solver: {hessian_projection: never, end_time: 1"));
   EXPECT_NE(e.find("scene.yaml:8:"), std::string::npos) << e;
   EXPECT_NE(e.find("solver.hessian_projection"), std::string::npos) << e;
-  EXPECT_NE(e.find("'adaptive' or 'always'"), std::string::npos) << e;
+  EXPECT_NE(e.find("one of 'adaptive', 'always'"), std::string::npos) << e;
+  e = error_of(replace(kGood, "solver: {end_time: 1", "solver: {linear_solver: superlu, end_time: 1"));
+  EXPECT_NE(e.find("solver.linear_solver"), std::string::npos) << e;
+  EXPECT_NE(e.find("one of 'mumps', 'mumps_lu', 'gamg'"), std::string::npos) << e;
   e = error_of(replace(kGood, "solver: {end_time: 1", "solver: {easy_newton_its: 2.5, end_time: 1"));
   EXPECT_NE(e.find("solver.easy_newton_its"), std::string::npos) << e;
   EXPECT_NE(e.find("positive integer"), std::string::npos) << e;
