@@ -206,7 +206,7 @@ Scene scene_from_yaml(const YAML::Node& root, const std::string& path) {
     positive("min_step", scene.solver.dt_min);
     positive("max_step", scene.solver.dt_max);
     positive("rtol", scene.solver.rtol);
-    // A choice of two names, or a positive integer.
+    // A choice among names, or a positive integer.
     const auto one_of = [&](const char* key, std::string& out, const std::vector<std::string>& allowed) {
       if (!s[key]) return;
       const std::string where = std::string("solver.") + key;

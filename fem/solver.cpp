@@ -86,10 +86,10 @@ QuasiStaticSolver::QuasiStaticSolver(Assembler& assembler, std::vector<Dirichlet
   if (opt_.linear_solver == "mumps" || opt_.linear_solver == "mumps_lu") {
     PETSC_CHECK(KSPSetType(ksp, J_ ? KSPGMRES : KSPPREONLY));
     if (J_) PETSC_CHECK(KSPSetTolerances(ksp, 1e-12, 1e-50, PETSC_DEFAULT, 100));
-    // Every term is an energy, so the Hessian is symmetric (mark_symmetric): MUMPS's
-    // LDL^T (symmetric indefinite with pivoting, since the exact Hessian need not be
-    // positive definite) does half the flops of LU and gives the same Newton
-    // iterates (README, "Verification: error against wall time").
+    // Every term is an energy, so the Hessian is symmetric (Assembler::create_matrix
+    // marks it so): MUMPS's LDL^T (symmetric indefinite with pivoting, since the exact
+    // Hessian need not be positive definite) does half the flops of LU and gives the
+    // same Newton iterates (README, "Linear solvers").
     PETSC_CHECK(PCSetType(pc, opt_.linear_solver == "mumps" ? PCCHOLESKY : PCLU));
     PETSC_CHECK(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
   } else if (opt_.linear_solver == "gamg") {
