@@ -19,6 +19,7 @@
 #include "core/errors.h"
 #include "core/json.h"
 #include "core/progress.h"
+#include "core/strings.h"
 #include "optim/fitness.h"
 
 namespace morphfem {
@@ -88,16 +89,12 @@ std::vector<std::string> options(const std::vector<std::string>& args, const std
 }
 
 std::string joined_options(const std::vector<std::string>& args, const std::string& name) {
-  std::string out;
-  for (const auto& value : options(args, name)) out += (out.empty() ? "" : "; ") + value;
-  return out;
+  return join(options(args, name), "; ");
 }
 
 std::vector<RobotCase> preset_cases(const std::string& preset, const std::vector<std::string>& allowed) {
   if (std::find(allowed.begin(), allowed.end(), preset) == allowed.end()) {
-    std::string known;
-    for (const auto& a : allowed) known += (known.empty() ? "" : ", ") + a;
-    throw InputError("--preset", "unknown preset '" + preset + "' (known: " + known + ")");
+    throw InputError("--preset", "unknown preset '" + preset + "' (known: " + join(allowed, ", ") + ")");
   }
   if (preset == "physical") return physical_baseline_cases(source_dir());
   if (preset == "lattice-mechanics") return lattice_mechanics_cases(source_dir());
@@ -151,11 +148,9 @@ const RobotFidelity& find_robot_fidelity(const std::string& name) {
     custom.push_back(level);
     return custom.back();
   }
-  std::string known;
-  for (const auto& level : robot_fidelity_levels()) {
+  for (const auto& level : robot_fidelity_levels())
     if (level.name == name) return level;
-    known += (known.empty() ? "" : ", ") + level.name;
-  }
+  const std::string known = join(robot_fidelity_levels(), ", ", [](const RobotFidelity& l) { return l.name; });
   throw InputError("--fidelity",
                    "unknown robot fidelity level '" + name + "' (known: " + known + ", or MESH_SIZE:ORDER:MAX_STEP)");
 }
@@ -403,12 +398,10 @@ std::vector<CaseOutcome> run_robot_jobs(const std::vector<std::pair<RobotCase, R
 }
 
 const RobotCase& find_case(const std::vector<RobotCase>& cases, const std::string& name) {
-  std::string known;
-  for (const auto& c : cases) {
+  for (const auto& c : cases)
     if (c.name == name) return c;
-    known += (known.empty() ? "" : ", ") + c.name;
-  }
-  throw InputError("--case", "unknown robot case '" + name + "' (known: " + known + ")");
+  throw InputError("--case", "unknown robot case '" + name +
+                                 "' (known: " + join(cases, ", ", [](const RobotCase& c) { return c.name; }) + ")");
 }
 
 Json outcome_json(const RobotCase& c, const RobotFidelity& level, const CaseOutcome& o) {
@@ -540,10 +533,11 @@ int validate(const std::vector<std::string>& args, MPI_Comm comm) {
   std::filesystem::create_directories(out_dir);
   Json summary;
   const std::string overrides = joined_options(args, "--set");  // the --set assignments, as given
-  std::string physical_overrides;
+  std::vector<std::string> physical_assignments;                // "set-physical KEY=VALUE", ...
   for (const char* flag : {"--set-physical", "--set-physical-round", "--set-physical-flat"})
     for (const auto& assignment : options(args, flag))
-      physical_overrides += (physical_overrides.empty() ? "" : "; ") + std::string(flag + 2) + " " + assignment;
+      physical_assignments.push_back(std::string(flag + 2) + " " + assignment);
+  const std::string physical_overrides = join(physical_assignments, "; ");
   summary.add("fidelity", level.name)
       .add("overrides", overrides)
       .add("physical_overrides", physical_overrides)

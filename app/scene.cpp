@@ -11,6 +11,7 @@
 #include "actuation/schedule_loads.h"
 #include "actuation/voxel_growth.h"
 #include "core/errors.h"
+#include "core/strings.h"
 #include "core/yaml_reader.h"
 #include "fem/elastic.h"
 #include "optim/calibration_file.h"
@@ -36,9 +37,7 @@ struct Reader {
     for (const auto& kv : map) {
       const std::string k = kv.first.as<std::string>();
       if (!allowed.count(k)) {
-        std::string list;
-        for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
-        fail(kv.first, key.empty() ? k : key + "." + k, "unknown key (allowed: " + list + ")");
+        fail(kv.first, key.empty() ? k : key + "." + k, "unknown key (allowed: " + join(allowed, ", ") + ")");
       }
     }
   }
@@ -62,14 +61,12 @@ struct Reader {
     const Calibration calibration = read_calibration_file(path.string());  // its errors name its file and line
     const std::string name = text(node["parameter"], key + ".parameter");
     const CalibratedValue* value = nullptr;
-    std::string known;
-    for (const auto& [n, v] : calibration.parameters) {
+    for (const auto& [n, v] : calibration.parameters)
       if (n == name) value = &v;
-      known += (known.empty() ? "" : ", ") + n;
-    }
     if (!value)
       fail(node["parameter"], key + ".parameter",
-           "'" + path.string() + "' has no parameter '" + name + "' (it has: " + known + ")");
+           "'" + path.string() + "' has no parameter '" + name +
+               "' (it has: " + join_keys(calibration.parameters, ", ") + ")");
     if (scene)
       scene->calibrations.push_back(
           {key, path.string(), sha256_file(path.string()), calibration.kind, name, value->value, value->std_error});
@@ -212,9 +209,7 @@ Scene scene_from_yaml(const YAML::Node& root, const std::string& path) {
       const std::string where = std::string("solver.") + key;
       out = r.text(s[key], where);
       if (std::find(allowed.begin(), allowed.end(), out) != allowed.end()) return;
-      std::string list;
-      for (const auto& a : allowed) list += (list.empty() ? "'" : ", '") + a + "'";
-      r.fail(s[key], where, "must be one of " + list);
+      r.fail(s[key], where, "must be one of '" + join(allowed, "', '") + "'");
     };
     const auto positive_integer = [&](const char* key, int& out) {
       if (!s[key]) return;
@@ -232,10 +227,9 @@ Scene scene_from_yaml(const YAML::Node& root, const std::string& path) {
     if (s["formulation"]) {
       scene.formulation = r.text(s["formulation"], "solver.formulation");
       if (!elastic_formulations().count(scene.formulation)) {
-        std::string known;
-        for (const auto& [name, f] : elastic_formulations()) known += (known.empty() ? "" : ", ") + name;
-        r.fail(s["formulation"], "solver.formulation",
-               "unknown formulation '" + scene.formulation + "' (known: " + known + ")");
+        r.fail(
+            s["formulation"], "solver.formulation",
+            "unknown formulation '" + scene.formulation + "' (known: " + join_keys(elastic_formulations(), ", ") + ")");
       }
     }
     if (s["quadrature_degree"]) {
@@ -434,9 +428,8 @@ Scene scene_from_yaml(const YAML::Node& root, const std::string& path) {
       const std::string name = r.text(d["scheme"], "dynamics.scheme");
       const auto it = time_schemes().find(name);
       if (it == time_schemes().end()) {
-        std::string known;
-        for (const auto& [k, v] : time_schemes()) known += (known.empty() ? "" : ", ") + k;
-        r.fail(d["scheme"], "dynamics.scheme", "unknown scheme '" + name + "' (known: " + known + ")");
+        r.fail(d["scheme"], "dynamics.scheme",
+               "unknown scheme '" + name + "' (known: " + join_keys(time_schemes(), ", ") + ")");
       }
       scene.inertia.scheme = it->second;
     }

@@ -25,6 +25,7 @@
 #include "core/json.h"
 #include "core/progress.h"
 #include "core/state_file.h"
+#include "core/strings.h"
 #include "fem/damping.h"
 #include "fem/elastic.h"
 #include "fem/inertia.h"
@@ -107,10 +108,8 @@ std::string scene_key(const Scene& scene, const std::string& where, const std::s
 void require_surface(const Scene& scene, const Mesh& mesh, const std::string& name, const std::string& where,
                      const std::string& key) {
   if (!mesh.has_region(name, 2)) {
-    std::string known;
-    for (const auto& n : mesh.region_names(2)) known += (known.empty() ? "" : ", ") + n;
-    throw InputError(scene_key(scene, where, key),
-                     "the mesh has no surface region '" + name + "' (it has: " + known + ")");
+    throw InputError(scene_key(scene, where, key), "the mesh has no surface region '" + name +
+                                                       "' (it has: " + join(mesh.region_names(2), ", ") + ")");
   }
 }
 
@@ -319,11 +318,9 @@ Mesh build_scene_mesh(const Scene& scene, MPI_Comm comm) {
   Mesh mesh = build_on_root(scene, comm);
   const std::string src = scene.source.empty() ? scene.name : scene.source;
   for (const auto& [region, params] : scene.materials)
-    if (!mesh.has_region(region, 3)) {
-      std::string known;
-      for (const auto& n : mesh.region_names(3)) known += (known.empty() ? "" : ", ") + n;
-      throw InputError(params.where("model"), "the mesh has no volume region '" + region + "' (it has: " + known + ")");
-    }
+    if (!mesh.has_region(region, 3))
+      throw InputError(params.where("model"), "the mesh has no volume region '" + region +
+                                                  "' (it has: " + join(mesh.region_names(3), ", ") + ")");
   for (const auto& name : mesh.region_names(3))
     if (!scene.materials.count(name))
       throw InputError(src + ": materials", "no material for volume region '" + name + "'");

@@ -14,6 +14,7 @@
 #include "app/verify_self_contact.h"
 #include "core/errors.h"
 #include "core/json.h"
+#include "core/strings.h"
 #include "fem/element.h"
 #include "fem/material.h"
 
@@ -517,11 +518,8 @@ std::vector<std::string> verification_case_names(bool hard) {
 std::vector<VerificationRecord> run_verification(const VerifyOptions& options, MPI_Comm comm) {
   std::vector<std::string> names = options.cases.empty() ? verification_case_names(options.hard) : options.cases;
   for (const auto& n : names)
-    if (!cases().count(n)) {
-      std::string known;
-      for (const auto& [k, entry] : cases()) known += (known.empty() ? "" : ", ") + k;
-      throw InputError("--case", "unknown verification case '" + n + "' (known: " + known + ")");
-    }
+    if (!cases().count(n))
+      throw InputError("--case", "unknown verification case '" + n + "' (known: " + join_keys(cases(), ", ") + ")");
   std::vector<VerificationRecord> out;
   for (const auto& n : names) cases().at(n).run(options, comm, out);
   return out;

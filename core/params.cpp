@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include "core/errors.h"
+#include "core/strings.h"
 
 namespace morphfem {
 
@@ -102,9 +103,7 @@ std::string ParamSet::string(const std::string& key, const std::string& fallback
 void ParamSet::allow_only(const std::set<std::string>& allowed) const {
   for (const auto& k : keys()) {
     if (!allowed.count(k)) {
-      std::string list;
-      for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
-      throw InputError(where(k), "unknown key '" + k + "' (allowed: " + list + ")");
+      throw InputError(where(k), "unknown key '" + k + "' (allowed: " + join(allowed, ", ") + ")");
     }
   }
 }

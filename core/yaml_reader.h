@@ -12,6 +12,7 @@
 #include <string>
 
 #include "core/errors.h"
+#include "core/strings.h"
 
 namespace morphfem {
 
@@ -89,9 +90,8 @@ struct YamlReader {
     for (auto it = map.begin(); it != map.end(); ++it) {
       std::string k = it->first.Scalar();
       if (!allowed.count(k)) {
-        std::string list;
-        for (auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
-        fail(it->first, key.empty() ? k : key + "." + k, "unknown key '" + k + "' (allowed: " + list + ")");
+        fail(it->first, key.empty() ? k : key + "." + k,
+             "unknown key '" + k + "' (allowed: " + join(allowed, ", ") + ")");
       }
     }
   }

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "core/errors.h"
+#include "core/strings.h"
 
 namespace morphfem {
 
@@ -106,9 +107,8 @@ std::unique_ptr<Material> make_material(const ParamSet& params) {
   const auto& registry = material_registry();
   auto it = registry.find(model);
   if (it == registry.end()) {
-    std::string known;
-    for (const auto& [name, factory] : registry) known += (known.empty() ? "" : ", ") + name;
-    throw InputError(params.where("model"), "unknown material model '" + model + "' (known: " + known + ")");
+    throw InputError(params.where("model"),
+                     "unknown material model '" + model + "' (known: " + join_keys(registry, ", ") + ")");
   }
   return it->second(params);
 }

@@ -4,6 +4,7 @@
 #include <limits>
 
 #include "core/errors.h"
+#include "core/strings.h"
 #include "fem/loads.h"
 #include "fem/material.h"
 
@@ -97,9 +98,8 @@ std::unique_ptr<MembraneLaw> make_membrane_law(const ParamSet& params) {
   const auto& registry = membrane_law_registry();
   const auto it = registry.find(model);
   if (it == registry.end()) {
-    std::string known;
-    for (const auto& kv : registry) known += (known.empty() ? "" : ", ") + kv.first;
-    throw InputError(params.where("model"), "unknown membrane model '" + model + "' (known: " + known + ")");
+    throw InputError(params.where("model"),
+                     "unknown membrane model '" + model + "' (known: " + join_keys(registry, ", ") + ")");
   }
   return it->second(params);
 }

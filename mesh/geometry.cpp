@@ -26,6 +26,7 @@
 #include <stdexcept>
 
 #include "core/errors.h"
+#include "core/strings.h"
 #include "mesh/robot.h"
 #include "mesh/solid_shapes.h"
 
@@ -350,9 +351,8 @@ Mesh build_geometry(const ParamSet& params) {
   const auto& registry = geometry_registry();
   auto it = registry.find(type);
   if (it == registry.end()) {
-    std::string known;
-    for (const auto& [name, builder] : registry) known += (known.empty() ? "" : ", ") + name;
-    throw InputError(params.where("type"), "unknown geometry type '" + type + "' (known: " + known + ")");
+    throw InputError(params.where("type"),
+                     "unknown geometry type '" + type + "' (known: " + join_keys(registry, ", ") + ")");
   }
   return it->second(params);
 }

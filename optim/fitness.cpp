@@ -5,6 +5,7 @@
 #include <map>
 
 #include "core/errors.h"
+#include "core/strings.h"
 #include "optim/genome.h"
 
 namespace morphfem {
@@ -48,9 +49,7 @@ bool has_fitness(const std::string& name) { return registry().count(name) > 0; }
 const FitnessFunction& find_fitness(const std::string& name) {
   auto it = registry().find(name);
   if (it == registry().end()) {
-    std::string known;
-    for (const auto& [n, e] : registry()) known += (known.empty() ? "" : ", ") + n;
-    throw InputError("--fitness", "unknown fitness '" + name + "' (known: " + known + ")");
+    throw InputError("--fitness", "unknown fitness '" + name + "' (known: " + join_keys(registry(), ", ") + ")");
   }
   return it->second.fn;
 }

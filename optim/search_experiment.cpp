@@ -13,6 +13,7 @@
 #include "core/errors.h"
 #include "core/json.h"
 #include "core/progress.h"
+#include "core/strings.h"
 #include "optim/checkpoint.h"
 #include "optim/search_method.h"
 #include "optim/search_partial.h"
@@ -332,8 +333,7 @@ const std::vector<ExperimentSpec>& search_experiments() {
 const ExperimentSpec& find_experiment(const std::string& name) {
   for (const auto& e : search_experiments())
     if (e.name == name) return e;
-  std::string known;
-  for (const auto& e : search_experiments()) known += (known.empty() ? "" : ", ") + e.name;
+  const std::string known = join(search_experiments(), ", ", [](const ExperimentSpec& e) { return e.name; });
   throw InputError("--experiments", "unknown experiment '" + name + "' (known: " + known + ")");
 }
 

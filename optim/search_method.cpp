@@ -3,6 +3,7 @@
 #include <functional>
 
 #include "core/errors.h"
+#include "core/strings.h"
 #include "optim/cmaes.h"
 #include "optim/hill_climber.h"
 
@@ -23,9 +24,8 @@ const std::map<std::string, Factory>& methods() {
 std::unique_ptr<SearchMethod> make_search_method(const std::string& name, const SearchSetup& setup) {
   auto it = methods().find(name);
   if (it == methods().end()) {
-    std::string known;
-    for (const auto& n : search_method_names()) known += (known.empty() ? "" : ", ") + n;
-    throw InputError("--method", "unknown search method '" + name + "' (known: " + known + ")");
+    throw InputError("--method",
+                     "unknown search method '" + name + "' (known: " + join(search_method_names(), ", ") + ")");
   }
   return it->second(setup);
 }
