@@ -11,12 +11,13 @@
 #include <random>
 #include <sstream>
 
-#include "app/calibrate_cli.h"
-#include "app/drag_scene.h"
-#include "app/scene.h"
-#include "app/simulation.h"
+#include "app/commands.h"
+#include "core/calibration_file.h"
 #include "core/errors.h"
-#include "optim/calibration_file.h"
+#include "optim/friction_calibration.h"
+#include "sim/drag_scene.h"
+#include "sim/scene.h"
+#include "sim/simulation.h"
 #include "tests/support/temp_dir.h"
 
 namespace morphfem {
@@ -68,15 +69,15 @@ TEST(CalibrateFriction, RecoversSimulatedCoefficientsWithinTwoPercent) {
 TEST(CalibrateFriction, CommandWritesCalibrationFileWithChecksums) {
   const auto dir = temp_dir("morphfem_calibrate_friction");
   for (int s = 1; s <= 2; ++s)
-    ASSERT_EQ(
-        calibrate_main({"drag", "--out", (dir / ("wood_uninflated_0" + std::to_string(s) + ".csv")).string(),
-                        "--mu-static", "0.56", "--mu-kinetic", "0.5", "--stiffness", "250", "--travel-mm", "5",
-                        "--noise-N", "0.003", "--seed", std::to_string(s), "--surface", "wood", "--foot", "uninflated"},
-                       PETSC_COMM_WORLD),
-        0);
-  ASSERT_EQ(calibrate_main({"friction", "--weight-N", "1", dir.string(), "--travel-mm", "5", "--max-evals", "25",
-                            "--out", (dir / "out").string()},
-                           PETSC_COMM_WORLD),
+    ASSERT_EQ(calibrate_command(
+                  {"drag", "--out", (dir / ("wood_uninflated_0" + std::to_string(s) + ".csv")).string(), "--mu-static",
+                   "0.56", "--mu-kinetic", "0.5", "--stiffness", "250", "--travel-mm", "5", "--noise-N", "0.003",
+                   "--seed", std::to_string(s), "--surface", "wood", "--foot", "uninflated"},
+                  PETSC_COMM_WORLD),
+              0);
+  ASSERT_EQ(calibrate_command({"friction", "--weight-N", "1", dir.string(), "--travel-mm", "5", "--max-evals", "25",
+                               "--out", (dir / "out").string()},
+                              PETSC_COMM_WORLD),
             0);
   const Calibration c = read_calibration_file((dir / "out" / "friction_wood_uninflated.yaml").string());
   EXPECT_EQ(c.kind, "friction");
@@ -91,14 +92,15 @@ TEST(CalibrateFriction, CommandWritesCalibrationFileWithChecksums) {
   EXPECT_EQ(verify_calibration_data(c).size(), 1u);
   EXPECT_TRUE(std::filesystem::exists(dir / "out" / "friction_overlay.csv"));
   // Several groups without --surface/--foot, or none matching, are errors.
-  ASSERT_EQ(calibrate_main({"drag", "--out", (dir / "acrylic_inflated_01.csv").string(), "--travel-mm", "5",
-                            "--surface", "acrylic", "--foot", "inflated"},
-                           PETSC_COMM_WORLD),
+  ASSERT_EQ(calibrate_command({"drag", "--out", (dir / "acrylic_inflated_01.csv").string(), "--travel-mm", "5",
+                               "--surface", "acrylic", "--foot", "inflated"},
+                              PETSC_COMM_WORLD),
             0);
-  EXPECT_THROW(calibrate_main({"friction", "--weight-N", "1", dir.string()}, PETSC_COMM_WORLD), InputError);
-  EXPECT_THROW(calibrate_main({"friction", "--weight-N", "1", dir.string(), "--surface", "gravel"}, PETSC_COMM_WORLD),
-               InputError);
-  EXPECT_THROW(calibrate_main({"bogus"}, PETSC_COMM_WORLD), InputError);
+  EXPECT_THROW(calibrate_command({"friction", "--weight-N", "1", dir.string()}, PETSC_COMM_WORLD), InputError);
+  EXPECT_THROW(
+      calibrate_command({"friction", "--weight-N", "1", dir.string(), "--surface", "gravel"}, PETSC_COMM_WORLD),
+      InputError);
+  EXPECT_THROW(calibrate_command({"bogus"}, PETSC_COMM_WORLD), InputError);
   std::filesystem::remove_all(dir);
 }
 

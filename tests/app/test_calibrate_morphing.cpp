@@ -13,10 +13,10 @@
 #include <sstream>
 #include <vector>
 
-#include "app/calibrate_cli.h"
-#include "app/scene.h"
+#include "app/commands.h"
+#include "core/calibration_file.h"
 #include "core/errors.h"
-#include "optim/calibration_file.h"
+#include "sim/scene.h"
 #include "tests/support/temp_dir.h"
 
 namespace morphfem {
@@ -50,8 +50,8 @@ TEST(CalibrateMorphing, ValveConductanceLandsOnTheTargetTime) {
                                           "       supply_pressure: [[0, 0], [0.1, 0], [0.11, 6000]], "
                                           "conductance: 8.0e-8}\n");
   const std::string out = (dir / "fit").string();
-  const int status = calibrate_morphing_main(
-      {"--scene", scene, "--out", out, "--inflate-s", "0.6", "--tolerance", "0.02", "--max-runs", "4"},
+  const int status = calibrate_command(
+      {"morphing", "--scene", scene, "--out", out, "--inflate-s", "0.6", "--tolerance", "0.02", "--max-runs", "4"},
       PETSC_COMM_WORLD);
   ASSERT_EQ(status, 0) << "the fit must converge";
   if (rank != 0) return;
@@ -103,9 +103,9 @@ TEST(CalibrateMorphing, SupplyAndVacuumConductancesLandOnBothTimes) {
                     "       supply_pressure: [[0, 0], [0.1, 0], [0.11, 6000], [3.0, 6000], [3.01, -1000]],\n"
                     "       conductance: 8.0e-8, vacuum_conductance: 8.0e-8}\n");
   const std::string out = (dir / "fit").string();
-  const int status = calibrate_morphing_main({"--scene", scene, "--out", out, "--inflate-s", "0.6", "--deflate-s",
-                                              "0.3", "--tolerance", "0.02", "--max-runs", "5"},
-                                             PETSC_COMM_WORLD);
+  const int status = calibrate_command({"morphing", "--scene", scene, "--out", out, "--inflate-s", "0.6", "--deflate-s",
+                                        "0.3", "--tolerance", "0.02", "--max-runs", "5"},
+                                       PETSC_COMM_WORLD);
   ASSERT_EQ(status, 0) << "the fit must converge";
   if (rank != 0) return;
   const Calibration c = read_calibration_file(out + "/morphing.yaml");
@@ -133,13 +133,13 @@ TEST(CalibrateMorphing, RefusesScenesWithoutAGasCavity) {
                                           "  cavities:\n"
                                           "    - {name: core, surfaces: [inner], pressure: 3000}\n");
   try {
-    calibrate_morphing_main({"--scene", scene, "--out", (dir / "fit").string()}, PETSC_COMM_WORLD);
+    calibrate_command({"morphing", "--scene", scene, "--out", (dir / "fit").string()}, PETSC_COMM_WORLD);
     FAIL() << "a scene without a gas cavity must be refused";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("gas cavity"), std::string::npos) << e.what();
   }
-  EXPECT_THROW(calibrate_morphing_main({"--scene", scene, "--fraction", "1.5"}, PETSC_COMM_WORLD), InputError);
-  EXPECT_THROW(calibrate_morphing_main({"--scene", scene, "--bogus", "1"}, PETSC_COMM_WORLD), InputError);
+  EXPECT_THROW(calibrate_command({"morphing", "--scene", scene, "--fraction", "1.5"}, PETSC_COMM_WORLD), InputError);
+  EXPECT_THROW(calibrate_command({"morphing", "--scene", scene, "--bogus", "1"}, PETSC_COMM_WORLD), InputError);
   EXPECT_FALSE(std::filesystem::exists(dir / "fit"));  // nothing written on bad input
   std::filesystem::remove_all(dir);
 }

@@ -8,12 +8,13 @@
 #include <fstream>
 
 #include "core/errors.h"
+#include "core/paths.h"
 #include "core/test_machine_export.h"
 
 namespace morphfem {
 namespace {
 
-const std::string kDataDir = std::string(MORPHFEM_SOURCE_DIR) + "/../shared/data/materials";
+const std::string kDataDir = shared_data_dir() + "/materials";
 
 // Every dialect below writes the same two rows: t = 0.5, 1.0 s, extension 0.8,
 // 1.6 mm and load 1.25, 2.5 N.

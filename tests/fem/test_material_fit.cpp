@@ -10,13 +10,14 @@
 
 #include "core/errors.h"
 #include "core/params.h"
+#include "core/paths.h"
 #include "fem/material.h"
 #include "fem/material_fit.h"
 
 namespace morphfem {
 namespace {
 
-const std::string kDataDir = std::string(MORPHFEM_SOURCE_DIR) + "/../shared/data/materials";
+const std::string kDataDir = shared_data_dir() + "/materials";
 
 std::vector<double> stretches(double lo, double hi, int n) {
   std::vector<double> l(n);

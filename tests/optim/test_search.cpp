@@ -12,6 +12,7 @@
 
 #include "actuation/schedule.h"
 #include "core/errors.h"
+#include "core/paths.h"
 #include "optim/checkpoint.h"
 #include "optim/cmaes.h"
 #include "optim/fitness.h"
@@ -418,7 +419,7 @@ TEST(SearchExperiment, HistoryCsvRoundTripsAndReadsTheVoxelStudy) {
   EXPECT_EQ(history_csv(h).substr(0, 9), "g,f_1,f_2");
   std::ofstream(path) << "g,f_1\n0,abc\n";
   EXPECT_THROW(read_history_csv(path), InputError);
-  const std::string voxel = std::string(MORPHFEM_SOURCE_DIR) + "/../shared/data/voxel-study/flat_open.csv";
+  const std::string voxel = shared_data_dir() + "/voxel-study/flat_open.csv";
   if (!std::filesystem::exists(voxel)) GTEST_SKIP() << "no voxel study data";
   const auto v = read_history_csv(voxel);
   ASSERT_EQ(v.size(), 201u);

@@ -1,0 +1,19 @@
+// The program's commands: each parses its arguments (core/command_line.h) and calls a
+// library. Every one returns the process's exit status and throws InputError on a bad
+// command line or input (exit 2) and SolveError on a failed solve (exit 3).
+#pragma once
+#include <mpi.h>
+
+#include <string>
+#include <vector>
+
+namespace morphfem {
+
+int run_command(const std::vector<std::string>& args, MPI_Comm comm);
+int verify_command(const std::vector<std::string>& args, MPI_Comm comm);
+int fit_materials_command(const std::vector<std::string>& args);
+int robot_command(const std::vector<std::string>& args, MPI_Comm comm);
+int search_command(const std::vector<std::string>& args, MPI_Comm comm);
+int calibrate_command(const std::vector<std::string>& args, MPI_Comm comm);
+
+}  // namespace morphfem
