@@ -60,8 +60,8 @@ double displacement_along_heading(const Scene& scene, const SimulationResult& r)
 TEST(GaitExamples, FirstColumnMovesTheWayTheGaitDoes) {
   for (const auto& example : gait_examples()) {
     YAML::Node doc = load_scene_yaml(example_path(example.name));
-    const double first_column_end = doc["actuation"]["start"].as<double>() +
-                                    doc["actuation"]["schedule"]["column_s"].as<double>();
+    const double first_column_end =
+        doc["actuation"]["start"].as<double>() + doc["actuation"]["schedule"]["column_s"].as<double>();
     set_scene_key(doc, "solver.end_time=" + std::to_string(first_column_end), "test");
     const Scene scene = scene_from_yaml(doc, example_path(example.name));
     const SimulationResult r = run_scene(scene, PETSC_COMM_WORLD, RunOptions(false, false));
