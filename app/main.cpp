@@ -49,6 +49,7 @@ std::string usage() {
     out += line;
   }
   out += "morphfem COMMAND --help tells a command's arguments.\n";
+  out += "examples, scripts and data: " + morphfem::resource_dir() + " (MORPHFEM_DATA_DIR overrides)\n";
   return out;
 }
 
