@@ -96,7 +96,7 @@ const CalibratedValue& Calibration::parameter(const std::string& name) const {
 std::string calibration_yaml(const Calibration& c) {
   std::ostringstream o;
   o << std::setprecision(10);
-  o << "# morphfem calibration file (written by morphfem calibrate; see optim/calibration_file.h)\n"
+  o << "# morphfem calibration file (written by morphfem calibrate; see core/calibration_file.h)\n"
     << "kind: " << quoted(c.kind) << "\n"
     << "command: " << quoted(c.command) << "\n"
     << "created: " << quoted(c.created) << "\n";

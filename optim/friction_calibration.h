@@ -12,7 +12,7 @@
 namespace morphfem {
 
 // Friction fit with the simulator: mu_static, mu_kinetic and the pull-spring
-// stiffness k of the drag test (app/drag_scene.h) so that the simulated force
+// stiffness k of the drag test (sim/drag_scene.h) so that the simulated force
 // reproduces every given curve up to `travel` (residuals and statistics in
 // optim/friction_fit.h). Starts from the pull-test analysis of the curves (median
 // peak and kinetic coefficients, median pre-slip slope) unless `start` is given.

@@ -136,14 +136,6 @@ Genome genome_from_vector(const std::array<double, kGenomeLength>& v, const std:
 
 bool operator==(const Genome& a, const Genome& b) { return genome_to_vector(a) == genome_to_vector(b); }
 
-std::string genome_string(const Genome& g) {
-  std::ostringstream o;
-  o << "theta=" << g.orientation_deg << " p=" << g.core_pressure_pa << " rows=[";
-  for (int r = 0; r < kNumRows; ++r) o << (r ? " " : "") << g.rows[r].f << ',' << g.rows[r].phi;
-  o << ']';
-  return o.str();
-}
-
 Genome rolling_genome() {
   Genome g;
   g.orientation_deg = 0;

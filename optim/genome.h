@@ -44,8 +44,6 @@ struct GenomeSpace {
   bool pressure_free = true;
   double fixed_orientation_deg = 0;
   double fixed_core_pressure_pa = 0;
-  // Number of free genes (20 row genes plus the free orientation/pressure).
-  int free_genes() const { return 2 * kNumRows + (orientation_free ? 1 : 0) + (pressure_free ? 1 : 0); }
 };
 
 // Counter-based random stream: a std::mt19937_64 seeded from (seed, stream, counter)
@@ -78,8 +76,6 @@ std::array<double, kGenomeLength> genome_to_vector(const Genome& g);
 // Inverse of genome_to_vector; throws InputError(where, ...) if a gene is out of range or not an integer.
 Genome genome_from_vector(const std::array<double, kGenomeLength>& v, const std::string& where);
 bool operator==(const Genome& a, const Genome& b);
-// "theta=.. p=.. rows=[f phi, ...]" for logs.
-std::string genome_string(const Genome& g);
 
 // Hand-designed schedules of the study as genomes (ROBOT.md):
 // rolling = bladders 8, 7, ..., 1 one per column, feet inactive, 0 deg, 12 kPa;

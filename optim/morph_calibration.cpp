@@ -45,103 +45,118 @@ double relative_error(double model, double target) { return model / target - 1; 
 
 }  // namespace
 
-int calibrate_morphing(const MorphingOptions& options, MPI_Comm comm) {
-  MorphingOptions o = options;
-  if (o.scene.empty()) o.scene = resource_dir() + "/examples/physical/morph_valve_vacuum_slice.yaml";
-  int rank = 0;
-  MPI_Comm_rank(comm, &rank);
+namespace {
+
+// The scene, its core cavity and the phases of its supply table.
+struct MorphSetup {
+  Scene scene;
+  MorphPhases phases;
+  bool vacuum = false;  // the supply turns to vacuum (a deflation phase)
+  Run start;            // the scene's own conductances
+  GasCavitySpec& core() { return scene.gas_cavities.front(); }
+};
+
+MorphSetup morph_setup(const MorphingOptions& o) {
+  MorphSetup m;
   YAML::Node doc = load_scene_yaml(o.scene);
   for (const std::string& assignment : o.sets) set_scene_key(doc, assignment, o.scene);
-  Scene scene = scene_from_yaml(doc, o.scene);
-  if (scene.gas_cavities.size() != 1)
+  m.scene = scene_from_yaml(doc, o.scene);
+  if (m.scene.gas_cavities.size() != 1)
     throw InputError(o.scene, "calibrate morphing needs exactly one gas cavity, the core (loads.gas_cavities)");
-  GasCavitySpec& core = scene.gas_cavities.front();
-  MorphPhases phases;
+  const GasCavitySpec& core = m.core();
   try {
-    phases = morph_phases(core.supply_gauge_pressure.points(), scene.solver.t_end);
+    m.phases = morph_phases(core.supply_gauge_pressure.points(), m.scene.solver.t_end);
   } catch (const std::invalid_argument& e) {
     throw InputError(o.scene, std::string("loads.gas_cavities.supply_pressure: ") + e.what());
   }
-  const bool vacuum = !std::isnan(phases.deflate);
-  Run next;
-  next.C_supply = core.conductance(phases.inflate);
-  next.C_vacuum = vacuum ? core.conductance_at(phases.end) : 0.0;
-  if (!(next.C_supply > 0 && (!vacuum || next.C_vacuum > 0)))
+  m.vacuum = !std::isnan(m.phases.deflate);
+  m.start.C_supply = core.conductance(m.phases.inflate);
+  m.start.C_vacuum = m.vacuum ? core.conductance_at(m.phases.end) : 0.0;
+  if (!(m.start.C_supply > 0 && (!m.vacuum || m.start.C_vacuum > 0)))
     throw InputError(o.scene,
                      "loads.gas_cavities.conductance (and vacuum_conductance): the starting values must be > 0");
+  return m;
+}
 
-  if (rank == 0)
-    std::printf(
-        "morphing fit: %s\n  phases: line from t = %.3f s, vacuum from t = %.3f s (nan: none), end %.3f s; times to "
-        "%.0f %% of the height change\n  targets: inflate %.3g s, deflate %.3g s (tolerance %.1f %%); diameter %.3g "
-        "cm, flat height "
-        "%.3g cm (predictions)\n",
-        o.scene.c_str(), phases.inflate, phases.deflate, phases.end, 100 * o.fraction, o.inflate_s, o.deflate_s,
-        100 * o.tolerance, 100 * o.diameter_m, 100 * o.height_m);
-  std::vector<Run> runs;
-  std::vector<std::pair<double, double>> supply_history, vacuum_history;  // (C, t)
-  bool converged = false;
-  const std::string header =
+// Runs the scene with the run's conductances, sampling the mid-length cross-section
+// after every step (its CSV in robot morph's layout).
+void run_morph(MorphSetup& m, Run& run, const std::string& output_dir, double fraction, MPI_Comm comm,
+               SimulationResult& r) {
+  GasCavitySpec& core = m.core();
+  core.conductance = TimeFunction::constant(run.C_supply);
+  core.vacuum_conductance = TimeFunction::constant(run.C_vacuum);
+  core.has_vacuum_conductance = m.vacuum;
+  m.scene.output_dir = output_dir;
+  std::vector<ShapeSample> samples;
+  run.csv = "time_s,core_pressure_pa,width_m,length_m,thickness_m,width_over_thickness\n";
+  RunOptions options;
+  options.on_step = [&](double t, const Mesh& mesh, const RowMatrixXd& u, const SimulationResult& sr) {
+    const Eigen::Vector3d e = cross_section_extents(mesh, u);
+    samples.push_back({t, e.x(), e.z()});
+    char line[200];
+    std::snprintf(line, sizeof line, "%.6g,%.6g,%.6g,%.6g,%.6g,%.6g\n", t, sr.cavity_pressure.at(0), e.x(), e.y(),
+                  e.z(), e.x() / e.z());
+    run.csv += line;
+  };
+  r = run_scene(m.scene, comm, options);
+  run.wall_s = r.stats.wall_s;
+  run.completed = r.stats.completed;
+  if (run.completed) run.m = measure_morphing(samples, m.phases, fraction);
+}
+
+void print_runs(const std::vector<Run>& runs, bool vacuum) {
+  std::fputs(
       "  run  C_supply [mol/(s Pa)]  C_vacuum [mol/(s Pa)]  inflate [s]  deflate [s]  diameter [cm]  flat height "
-      "[cm]  settled  wall [s]\n";
-  for (int k = 0; k < o.max_runs && !converged; ++k) {
+      "[cm]  settled  wall [s]\n",
+      stdout);
+  for (size_t j = 0; j < runs.size(); ++j) {
+    const Run& x = runs[j];
+    const std::string deflate_settled = !vacuum ? "-" : x.m.deflate_settled ? "yes" : "no";
+    std::printf("  %3zu  %21.4e  %21.4e  %11.3f  %11.3f  %13.2f  %16.2f  %3s/%-3s  %8.1f\n", j + 1, x.C_supply,
+                x.C_vacuum, x.m.inflate_time, x.m.deflate_time, 100 * x.m.inflated_diameter, 100 * x.m.flat_height,
+                x.m.inflate_settled ? "yes" : "no", deflate_settled.c_str(), x.wall_s);
+  }
+  std::fflush(stdout);
+}
+
+// Runs until both times are within the tolerance (or max_runs): each run's
+// conductances come from the secant update of the previous ones. Returns whether
+// the times converged; `runs` holds every run.
+bool fit_conductances(MorphSetup& m, const MorphingOptions& o, MPI_Comm comm, int rank, std::vector<Run>& runs) {
+  std::vector<std::pair<double, double>> supply_history, vacuum_history;  // (C, t)
+  Run next = m.start;
+  for (int k = 0; k < o.max_runs; ++k) {
     Run run = next;
-    core.conductance = TimeFunction::constant(run.C_supply);
-    core.vacuum_conductance = TimeFunction::constant(run.C_vacuum);
-    core.has_vacuum_conductance = vacuum;
-    scene.output_dir = o.out + "/run_" + std::to_string(k + 1);
-    std::vector<ShapeSample> samples;
-    run.csv = "time_s,core_pressure_pa,width_m,length_m,thickness_m,width_over_thickness\n";
-    RunOptions options;
-    options.on_step = [&](double t, const Mesh& mesh, const RowMatrixXd& u, const SimulationResult& r) {
-      const Eigen::Vector3d e = cross_section_extents(mesh, u);
-      samples.push_back({t, e.x(), e.z()});
-      char line[200];
-      std::snprintf(line, sizeof line, "%.6g,%.6g,%.6g,%.6g,%.6g,%.6g\n", t, r.cavity_pressure.at(0), e.x(), e.y(),
-                    e.z(), e.x() / e.z());
-      run.csv += line;
-    };
-    const SimulationResult r = run_scene(scene, comm, options);
-    run.wall_s = r.stats.wall_s;
-    run.completed = r.stats.completed;
+    SimulationResult r;
+    run_morph(m, run, o.out + "/run_" + std::to_string(k + 1), o.fraction, comm, r);
+    runs.push_back(run);
     if (!run.completed) {
       if (rank == 0) std::printf("run %d failed: %s\n", k + 1, r.stats.failure.c_str());
-      runs.push_back(run);
-      break;
+      return false;
     }
-    run.m = measure_morphing(samples, phases, o.fraction);
-    runs.push_back(run);
     if (!r.output_dir.empty() && rank == 0) write_file_atomic(r.output_dir + "/morph.csv", run.csv);
-    if (rank == 0) {
-      std::fputs(header.c_str(), stdout);
-      for (size_t j = 0; j < runs.size(); ++j) {
-        const Run& x = runs[j];
-        const std::string deflate_settled = !vacuum ? "-" : x.m.deflate_settled ? "yes" : "no";
-        std::printf("  %3zu  %21.4e  %21.4e  %11.3f  %11.3f  %13.2f  %16.2f  %3s/%-3s  %8.1f\n", j + 1, x.C_supply,
-                    x.C_vacuum, x.m.inflate_time, x.m.deflate_time, 100 * x.m.inflated_diameter, 100 * x.m.flat_height,
-                    x.m.inflate_settled ? "yes" : "no", deflate_settled.c_str(), x.wall_s);
-      }
-      std::fflush(stdout);
-    }
+    if (rank == 0) print_runs(runs, m.vacuum);
     const auto positive = [](double t) { return std::isfinite(t) && t > 0; };
-    if (!positive(run.m.inflate_time) || (vacuum && !positive(run.m.deflate_time))) {
+    if (!positive(run.m.inflate_time) || (m.vacuum && !positive(run.m.deflate_time))) {
       if (rank == 0) std::printf("the run did not change shape in every phase: no update possible\n");
-      break;
+      return false;
     }
-    converged = std::abs(relative_error(run.m.inflate_time, o.inflate_s)) <= o.tolerance &&
-                (!vacuum || std::abs(relative_error(run.m.deflate_time, o.deflate_s)) <= o.tolerance);
+    if (std::abs(relative_error(run.m.inflate_time, o.inflate_s)) <= o.tolerance &&
+        (!m.vacuum || std::abs(relative_error(run.m.deflate_time, o.deflate_s)) <= o.tolerance))
+      return true;
     supply_history.emplace_back(run.C_supply, run.m.inflate_time);
     next.C_supply = next_conductance(supply_history, o.inflate_s);
-    if (vacuum) {
+    if (m.vacuum) {
       vacuum_history.emplace_back(run.C_vacuum, run.m.deflate_time);
       next.C_vacuum = next_conductance(vacuum_history, o.deflate_s);
     }
   }
-  if (runs.empty() || !runs.back().completed) return 3;
-  const Run& best = runs.back();
-  const MorphMeasures& m = best.m;
-  if (rank != 0) return converged ? 0 : 4;
+  return false;
+}
 
+// The measured quantities beside the model's: the two fitted times and the two
+// predicted sizes.
+void print_comparison(const MorphingOptions& o, const MorphMeasures& m, bool vacuum, bool converged, size_t n_runs) {
   struct Row {
     const char* name;
     double target, model;
@@ -172,8 +187,14 @@ int calibrate_morphing(const MorphingOptions& options, MPI_Comm comm) {
   if (!m.inflate_settled || (vacuum && !m.deflate_settled))
     std::printf("  warning: a phase had not settled at its end (lengthen it in the scene's supply table)\n");
   std::printf("  times %s after %zu runs; all four within 10 %%: %s\n", converged ? "converged" : "NOT converged",
-              runs.size(), within_10 ? "yes" : "no");
+              n_runs, within_10 ? "yes" : "no");
+}
 
+// The calibration file scenes load, the runs' table, the last run's shape and its plot.
+void write_morph_calibration(const MorphingOptions& o, MorphSetup& setup, const std::vector<Run>& runs,
+                             bool converged) {
+  const Run& best = runs.back();
+  const MorphMeasures& m = best.m;
   std::filesystem::create_directories(o.out);
   Calibration cal;
   cal.kind = "morphing";
@@ -183,11 +204,11 @@ int calibrate_morphing(const MorphingOptions& options, MPI_Comm comm) {
   // The scene as a path relative to the repository when it is in it (files that travel).
   const std::string source = resource_dir() + "/";
   const std::string scene_name = o.scene.rfind(source, 0) == 0 ? o.scene.substr(source.size()) : o.scene;
-  cal.group = {{"scene", scene_name}, {"cavity", core.wall.name}};
+  cal.group = {{"scene", scene_name}, {"cavity", setup.core().wall.name}};
   // The published times are means of 20 cycles without a spread: no standard error.
   cal.parameters.emplace_back("conductance_supply",
                               CalibratedValue{best.C_supply, 0.0, best.C_supply, best.C_supply, "mol/(s Pa)"});
-  if (vacuum)
+  if (setup.vacuum)
     cal.parameters.emplace_back("conductance_vacuum",
                                 CalibratedValue{best.C_vacuum, 0.0, best.C_vacuum, best.C_vacuum, "mol/(s Pa)"});
   cal.fit = {{"method", "log-log secant on the valve conductances (optim/morph_fit.h)"},
@@ -219,6 +240,30 @@ int calibrate_morphing(const MorphingOptions& options, MPI_Comm comm) {
   run_plot_script("plot_morph.py", {o.out + "/morph.csv"}, "the morphing fit");
   std::printf("calibration: %s\nruns: %s/morphing_runs.csv; last run: %s/morph.csv, %s/morph.png\n", yaml.c_str(),
               o.out.c_str(), o.out.c_str(), o.out.c_str());
+}
+
+}  // namespace
+
+int calibrate_morphing(const MorphingOptions& options, MPI_Comm comm) {
+  MorphingOptions o = options;
+  if (o.scene.empty()) o.scene = resource_dir() + "/examples/physical/morph_valve_vacuum_slice.yaml";
+  int rank = 0;
+  MPI_Comm_rank(comm, &rank);
+  MorphSetup setup = morph_setup(o);
+  if (rank == 0)
+    std::printf(
+        "morphing fit: %s\n  phases: line from t = %.3f s, vacuum from t = %.3f s (nan: none), end %.3f s; times to "
+        "%.0f %% of the height change\n  targets: inflate %.3g s, deflate %.3g s (tolerance %.1f %%); diameter %.3g "
+        "cm, flat height "
+        "%.3g cm (predictions)\n",
+        o.scene.c_str(), setup.phases.inflate, setup.phases.deflate, setup.phases.end, 100 * o.fraction, o.inflate_s,
+        o.deflate_s, 100 * o.tolerance, 100 * o.diameter_m, 100 * o.height_m);
+  std::vector<Run> runs;
+  const bool converged = fit_conductances(setup, o, comm, rank, runs);
+  if (runs.empty() || !runs.back().completed) return 3;
+  if (rank != 0) return converged ? 0 : 4;
+  print_comparison(o, runs.back().m, setup.vacuum, converged, runs.size());
+  write_morph_calibration(o, setup, runs, converged);
   return converged ? 0 : 4;
 }
 

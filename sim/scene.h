@@ -54,7 +54,7 @@
 //   contact:
 //     ground: {point: [0, 0, 0], normal: [0, 0, 1], surfaces: [zmin], dhat: 0, kappa: 0}
 //             # 0: defaults, dhat 1e-3 x box diagonal, kappa [Pa] 3 mu of the material under
-//             # most of the surfaces' area (contact_shear_modulus, app/simulation.h)
+//             # most of the surfaces' area (contact_shear_modulus, sim/simulation.h)
 //     friction: {eps_v: 1e-4, lag_updates: 0,
 //                regions: [{surface: zmin, mu_static: 0.5, mu_kinetic: 0.4}]}
 //                # mu: a number or a table [[t, mu], ...] (coefficients that change over time)
@@ -202,7 +202,7 @@ struct Scene {
   bool self_contact = false;  // self-contact between declared surface pairs
   SelfContactSpec self_contact_spec;
   std::string schedule_file;  // the actuation schedule, if any (its loads are in cavities/friction)
-  // Values taken from calibration files (optim/calibration_file.h), recorded in summary.json.
+  // Values taken from calibration files (core/calibration_file.h), recorded in summary.json.
   struct CalibrationUse {
     std::string key, file, sha256, kind, parameter;
     double value = 0, std_error = 0;

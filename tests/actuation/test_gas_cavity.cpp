@@ -3,7 +3,7 @@
 // term against finite differences at random states (P1 and P2 octant shells), the
 // implicit valve step, and the valve's fill-time scaling for a rigid cavity.
 // (Assembled-vector paths, volume control hitting V* and the FE fill test need
-// PETSc: tests/app/test_verify_gas.cpp.)
+// PETSc: tests/verify/test_verify_gas.cpp.)
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -7,7 +7,7 @@
 #    match the uninterrupted run's (relative 1e-10), and the result has every step.
 file(REMOVE_RECURSE ${WORK})
 file(MAKE_DIRECTORY ${WORK})
-# The resume tests' sliding block (tests/app/scenes/slide.yaml), larger and run longer,
+# The resume tests' sliding block (tests/sim/scenes/slide.yaml), larger and run longer,
 # so that the kill comes well before the end.
 set(scene ${SCENE} --set geometry.lx=0.04 --set geometry.ly=0.04 --set geometry.mesh_size=0.005
           --set solver.end_time=1.5 --set solver.max_step=0.01 --set output.every=10)

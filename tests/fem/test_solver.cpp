@@ -3,7 +3,7 @@
 // fallbacks must carry the solve: a direction that does not descend (the exact
 // Hessian negative definite), and a descent direction along which the line search
 // finds no decrease (the exact Hessian nearly singular: a step 1e14 times too long).
-// (The fallbacks on real terms: the tube-vacuum test in tests/app.)
+// (The fallbacks on real terms: the tube-vacuum test in tests/verify.)
 #include <gtest/gtest.h>
 #include <petscvec.h>
 

@@ -1,4 +1,4 @@
-// `morphfem robot friction-drag` (app/robot_drag.cpp): the pull test on the physical
+// `morphfem robot friction-drag` (robot/robot_drag.cpp): the pull test on the physical
 // laminate standing on its foot pads, on a coarse mesh and 6 mm of travel. Checks what
 // the physics fixes exactly: the weight is the robot's mass (analytic region volumes x
 // densities) x g; once the robot slides, the load cell reads mu W with mu the feet's

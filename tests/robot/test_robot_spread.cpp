@@ -1,4 +1,4 @@
-// `morphfem robot spread` (app/robot_spread.cpp): the --vary parser, the ensemble
+// `morphfem robot spread` (robot/robot_spread.cpp): the --vary parser, the ensemble
 // statistics, and one cheap ensemble end to end (the varied key reaches every run).
 #include <gtest/gtest.h>
 #include <petscsys.h>

@@ -1,4 +1,4 @@
-// Robot cases (app/robot_study.h): the template keys a case sets, the baseline
+// Robot cases (robot/robot_study.h): the template keys a case sets, the baseline
 // cases of the voxel study, inline schedules, and one cheap run that must not drift.
 #include <gtest/gtest.h>
 #include <petscsys.h>

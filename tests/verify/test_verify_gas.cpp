@@ -1,7 +1,7 @@
 // Gas-filled and volume-controlled cavities with PETSc: the assembled Newton
 // operator (sparse Hessian + dense rank-1 vector) against finite differences of the
 // assembled gradient, volume control hitting V*, quick coarse versions of the
-// verification cases (app/verify_gas.h), and graceful failure of pressure control
+// verification cases (verify/verify_gas.h), and graceful failure of pressure control
 // past the balloon's pressure maximum.
 #include <gtest/gtest.h>
 #include <petscvec.h>
