@@ -29,10 +29,58 @@ std::string as_given(const Args& args) {
 }
 
 int pull_tests(const Args& args, MPI_Comm) {
-  return pull_tests_main(args, resource_dir() + "/scripts/plot_calibration.py", std::cout);
+  CommandLine cl("morphfem calibrate pull-tests", "--weight-N W FILES_OR_DIRS... [options]",
+                 "Static (the study's: end of the linear regime; ASTM D1894: peak) and kinetic friction "
+                 "coefficients of test-machine pull tests, with statistics per surface and foot state.");
+  cl.value("--weight-N", "W", "the robot's weight [N] (required)")
+      .value("--out", "DIR", "pull_tests.csv, pull_summary.json and a box plot")
+      .positionals(1, -1, "FILES_OR_DIRS");
+  if (!cl.parse(args, std::cout)) return 0;
+  PullTestsOptions o;
+  if (!cl.has("--weight-N"))
+    throw InputError("calibrate pull-tests", "--weight-N W (the robot's weight [N]) is required");
+  o.weight_N = cl.number("--weight-N", 0, 1e-9, 1e6);
+  o.inputs = cl.positional();
+  o.out_dir = cl.get("--out", "");
+  o.plot_script = resource_dir() + "/scripts/plot_calibration.py";
+  o.command_arguments = as_given(args);
+  return analyse_pull_tests(o, std::cout);
 }
 
-int synth_pull(const Args& args, MPI_Comm) { return synth_pull_main(args, std::cout); }
+int synth_pull(const Args& args, MPI_Comm) {
+  CommandLine cl("morphfem calibrate synth-pull", "--out DIR [options]",
+                 "Synthetic Instron-like pull-test exports with known coefficients (for testing the analysis).");
+  cl.value("--out", "DIR", "where the exports go (required)")
+      .value("--surface", "NAME", "surface (default wood)")
+      .value("--foot", "STATE", "foot state (default inflated)")
+      .value("--mu-linear", "M", "coefficient at the end of the linear regime (default 0.70)")
+      .value("--mu-peak", "M", "peak coefficient (default 0.74)")
+      .value("--mu-kinetic", "M", "kinetic coefficient (default 0.60)")
+      .value("--weight-N", "W", "weight [N] (default 1)")
+      .value("--stiffness", "K", "pre-slip slope [N/m] (default 250)")
+      .value("--noise-N", "S", "load-cell noise [N] (default 0.005)")
+      .value("--repeats", "N", "exports written (default 10)")
+      .value("--seed", "N", "base seed (default 1)")
+      .value("--rate-Hz", "F", "sampling rate [Hz] (default 50)")
+      .flag("--decimal-comma", "write decimal commas");
+  if (!cl.parse(args, std::cout)) return 0;
+  SyntheticPullSet set;
+  SyntheticPull& p = set.model;
+  p.mu_linear = cl.number("--mu-linear", 0.70, 1e-3, 10);
+  p.mu_peak = cl.number("--mu-peak", 0.74, 1e-3, 10);
+  p.mu_kinetic = cl.number("--mu-kinetic", 0.60, 1e-3, 10);
+  p.weight_N = cl.number("--weight-N", p.weight_N, 1e-3, 1e4);
+  p.stiffness_N_per_m = cl.number("--stiffness", p.stiffness_N_per_m, 1.0, 1e7);
+  p.noise_N = cl.number("--noise-N", p.noise_N, 0.0, 1e3);
+  p.rate_Hz = cl.number("--rate-Hz", p.rate_Hz, 1.0, 1e4);
+  p.seed = static_cast<unsigned>(cl.number("--seed", p.seed, 0, 1e9));
+  set.repeats = cl.integer("--repeats", set.repeats, 1, 1000);
+  set.out_dir = cl.get("--out", "");
+  set.surface = cl.get("--surface", set.surface);
+  set.foot = cl.get("--foot", set.foot);
+  set.decimal_comma = cl.has("--decimal-comma");
+  return write_synthetic_pulls(set, std::cout);
+}
 
 int drag(const Args& args, MPI_Comm comm) {
   CommandLine cl("morphfem calibrate drag", "--out FILE.csv [options]",

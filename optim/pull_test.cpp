@@ -70,12 +70,6 @@ std::vector<std::string> name_tokens(const std::string& stem) {
   return tokens;
 }
 
-std::optional<double> number_arg(const std::string& text) {
-  double v;
-  if (!parse_export_number(text, false, v)) return std::nullopt;
-  return v;
-}
-
 }  // namespace
 
 PullCurve pull_curve_from_export(const SpecimenExport& s) {
@@ -317,66 +311,12 @@ std::string pull_export_text(const PullCurve& c, double weight_N, bool decimal_c
   return o.str();
 }
 
-int synth_pull_main(const std::vector<std::string>& args, std::ostream& out) {
-  const std::string usage =
-      "usage: morphfem calibrate synth-pull --out DIR [--surface wood] [--foot inflated] [--mu-linear 0.70]\n"
-      "       [--mu-peak 0.74] [--mu-kinetic 0.60] [--weight-N 1] [--stiffness 250] [--noise-N 0.005]\n"
-      "       [--repeats 10] [--seed 1] [--rate-Hz 50] [--decimal-comma]";
-  SyntheticPull p;
-  p.mu_linear = 0.70;
-  p.mu_peak = 0.74;
-  p.mu_kinetic = 0.60;
-  std::string dir, surface = "wood", foot = "inflated";
-  int repeats = 10;
-  bool comma = false;
-  for (size_t i = 0; i < args.size(); ++i) {
-    const std::string& a = args[i];
-    auto value = [&]() -> const std::string& {
-      if (i + 1 >= args.size()) throw InputError("calibrate synth-pull", "option " + a + " needs a value; " + usage);
-      return args[++i];
-    };
-    auto number = [&](double lo, double hi) {
-      const std::string& v = value();
-      const auto x = number_arg(v);
-      if (!x || *x < lo || *x > hi)
-        throw InputError("calibrate synth-pull",
-                         a + " '" + v + "' must be a number in [" + json_number(lo) + ", " + json_number(hi) + "]");
-      return *x;
-    };
-    if (a == "--out")
-      dir = value();
-    else if (a == "--surface")
-      surface = value();
-    else if (a == "--foot")
-      foot = value();
-    else if (a == "--mu-linear")
-      p.mu_linear = number(1e-3, 10);
-    else if (a == "--mu-peak")
-      p.mu_peak = number(1e-3, 10);
-    else if (a == "--mu-kinetic")
-      p.mu_kinetic = number(1e-3, 10);
-    else if (a == "--weight-N")
-      p.weight_N = number(1e-3, 1e4);
-    else if (a == "--stiffness")
-      p.stiffness_N_per_m = number(1.0, 1e7);
-    else if (a == "--noise-N")
-      p.noise_N = number(0.0, 1e3);
-    else if (a == "--rate-Hz")
-      p.rate_Hz = number(1.0, 1e4);
-    else if (a == "--repeats")
-      repeats = static_cast<int>(number(1, 1000));
-    else if (a == "--seed")
-      p.seed = static_cast<unsigned>(number(0, 1e9));
-    else if (a == "--decimal-comma")
-      comma = true;
-    else if (a == "--help" || a == "-h") {
-      out << usage << "\n";
-      return 0;
-    } else {
-      throw InputError("calibrate synth-pull", "unknown argument '" + a + "'; " + usage);
-    }
-  }
-  if (dir.empty()) throw InputError("calibrate synth-pull", "--out DIR is required; " + usage);
+int write_synthetic_pulls(const SyntheticPullSet& set, std::ostream& out) {
+  SyntheticPull p = set.model;
+  const std::string &dir = set.out_dir, &surface = set.surface, &foot = set.foot;
+  const int repeats = set.repeats;
+  const bool comma = set.decimal_comma;
+  if (dir.empty()) throw InputError("calibrate synth-pull", "--out DIR is required");
   if (p.mu_peak < p.mu_linear) throw InputError("calibrate synth-pull", "--mu-peak must be >= --mu-linear");
   std::filesystem::create_directories(dir);
   const unsigned seed0 = p.seed;
@@ -395,34 +335,13 @@ int synth_pull_main(const std::vector<std::string>& args, std::ostream& out) {
   return 0;
 }
 
-int pull_tests_main(const std::vector<std::string>& args, const std::string& plot_script, std::ostream& out) {
-  const std::string usage = "usage: morphfem calibrate pull-tests --weight-N W FILES_OR_DIRS... [--out DIR]";
-  double weight = 0;
-  std::string dir;
-  std::vector<std::string> inputs;
-  for (size_t i = 0; i < args.size(); ++i) {
-    const std::string& a = args[i];
-    if (a == "--weight-N" || a == "--out") {
-      if (i + 1 >= args.size()) throw InputError("calibrate pull-tests", "option " + a + " needs a value; " + usage);
-      const std::string& v = args[++i];
-      if (a == "--out") {
-        dir = v;
-      } else {
-        const auto w = number_arg(v);
-        if (!w || *w <= 0) throw InputError("calibrate pull-tests", "--weight-N '" + v + "' must be a weight > 0 [N]");
-        weight = *w;
-      }
-    } else if (a == "--help" || a == "-h") {
-      out << usage << "\n";
-      return 0;
-    } else if (!a.empty() && a[0] == '-') {
-      throw InputError("calibrate pull-tests", "unknown option '" + a + "'; " + usage);
-    } else {
-      inputs.push_back(a);
-    }
-  }
+int analyse_pull_tests(const PullTestsOptions& o, std::ostream& out) {
+  const double weight = o.weight_N;
+  const std::string& dir = o.out_dir;
+  const std::vector<std::string>& inputs = o.inputs;
+  const std::string& plot_script = o.plot_script;
   if (weight <= 0) throw InputError("calibrate pull-tests", "--weight-N W (the robot's weight [N]) is required");
-  if (inputs.empty()) throw InputError("calibrate pull-tests", "no export files or folders given; " + usage);
+  if (inputs.empty()) throw InputError("calibrate pull-tests", "no export files or folders given");
   const auto specimens = read_test_machine_exports(inputs);
   struct Row {
     PullCurve curve;
@@ -488,9 +407,9 @@ int pull_tests_main(const std::vector<std::string>& args, const std::string& plo
     const std::string csv_path = (std::filesystem::path(dir) / "pull_tests.csv").string();
     write_file_atomic(csv_path, csv.str());
     Json root;
-    std::string cmd = "morphfem calibrate pull-tests";
-    for (const auto& a : args) cmd += " " + a;
-    root.add("command", cmd).add("weight_N", weight).add("groups", json_groups);
+    root.add("command", "morphfem calibrate pull-tests" + o.command_arguments)
+        .add("weight_N", weight)
+        .add("groups", json_groups);
     write_file_atomic((std::filesystem::path(dir) / "pull_summary.json").string(), root.str(true) + "\n");
     if (!plot_script.empty() && std::filesystem::exists("/usr/bin/python3") && std::filesystem::exists(plot_script)) {
       const std::string png = (std::filesystem::path(dir) / "pull_boxplot.png").string();

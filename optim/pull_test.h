@@ -114,11 +114,27 @@ PullCurve synthesize_pull(const SyntheticPull& p);
 std::string pull_export_text(const PullCurve& curve, double weight_N, bool decimal_comma,
                              const std::string& machine = "Instron 3343 (synthetic)", double speed_mm_per_min = 100.0);
 
-// `morphfem calibrate pull-tests --weight-N W FILES_OR_DIRS... [--out DIR]` and
-// `morphfem calibrate synth-pull --out DIR [--surface S --foot F --mu-linear ...]`.
-// Print a table; --out writes pull_tests.csv (one row per test), pull_summary.json
-// and (if /usr/bin/python3 and `plot_script` exist) pull_boxplot.png.
-int pull_tests_main(const std::vector<std::string>& args, const std::string& plot_script, std::ostream& out);
-int synth_pull_main(const std::vector<std::string>& args, std::ostream& out);
+// `morphfem calibrate pull-tests`: the coefficients of every test, a table, and per
+// group (surface, foot state) their statistics; with out_dir, pull_tests.csv (one row
+// per test), pull_summary.json and (if /usr/bin/python3 and `plot_script` exist)
+// pull_boxplot.png. InputError if the weight is not > 0 or no input is given.
+struct PullTestsOptions {
+  double weight_N = 0;              // the robot's weight [N]
+  std::vector<std::string> inputs;  // export files or folders
+  std::string out_dir;              // empty: print only
+  std::string plot_script;          // scripts/plot_calibration.py ("" : no plot)
+  std::string command_arguments;    // recorded in pull_summary.json
+};
+int analyse_pull_tests(const PullTestsOptions& options, std::ostream& out);
+
+// `morphfem calibrate synth-pull`: `repeats` synthetic exports (seeds seed+1, ...) of
+// one surface and foot state in out_dir, their paths printed to `out`.
+struct SyntheticPullSet {
+  SyntheticPull model;
+  std::string out_dir, surface = "wood", foot = "inflated";
+  int repeats = 10;
+  bool decimal_comma = false;
+};
+int write_synthetic_pulls(const SyntheticPullSet& set, std::ostream& out);
 
 }  // namespace morphfem

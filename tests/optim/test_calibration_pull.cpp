@@ -86,12 +86,23 @@ TEST(CalibrationPull, ExportsRoundTripAndCommandGroupsBySurfaceAndFoot) {
   const auto dir = std::filesystem::path(::testing::TempDir()) / ("morphfem_pull_" + std::to_string(::getpid()));
   std::filesystem::remove_all(dir);
   std::ostringstream ignored;
-  ASSERT_EQ(
-      synth_pull_main({"--out", (dir / "a").string(), "--surface", "acrylic", "--foot", "uninflated", "--mu-linear",
-                       "0.38", "--mu-peak", "0.40", "--mu-kinetic", "0.33", "--repeats", "3", "--decimal-comma"},
-                      ignored),
-      0);
-  ASSERT_EQ(synth_pull_main({"--out", (dir / "b").string(), "--repeats", "2"}, ignored), 0);
+  SyntheticPullSet acrylic;
+  acrylic.out_dir = (dir / "a").string();
+  acrylic.surface = "acrylic";
+  acrylic.foot = "uninflated";
+  acrylic.model.mu_linear = 0.38;
+  acrylic.model.mu_peak = 0.40;
+  acrylic.model.mu_kinetic = 0.33;
+  acrylic.repeats = 3;
+  acrylic.decimal_comma = true;
+  ASSERT_EQ(write_synthetic_pulls(acrylic, ignored), 0);
+  SyntheticPullSet wood;  // wood, inflated
+  wood.out_dir = (dir / "b").string();
+  wood.model.mu_linear = 0.70;
+  wood.model.mu_peak = 0.74;
+  wood.model.mu_kinetic = 0.60;
+  wood.repeats = 2;
+  ASSERT_EQ(write_synthetic_pulls(wood, ignored), 0);
   // The export reads back with surface and foot state from the header block.
   const auto blocks = read_test_machine_export((dir / "a" / "acrylic_uninflated_01.csv").string());
   const PullCurve c = pull_curve_from_export(blocks.at(0));
@@ -100,10 +111,11 @@ TEST(CalibrationPull, ExportsRoundTripAndCommandGroupsBySurfaceAndFoot) {
   EXPECT_NEAR(c.displacement.back(), 0.130, 1e-4);
 
   std::ostringstream out;
-  ASSERT_EQ(
-      pull_tests_main({"--weight-N", "1", (dir / "a").string(), (dir / "b").string(), "--out", (dir / "out").string()},
-                      "", out),
-      0);
+  PullTestsOptions both;
+  both.weight_N = 1;
+  both.inputs = {(dir / "a").string(), (dir / "b").string()};
+  both.out_dir = (dir / "out").string();
+  ASSERT_EQ(analyse_pull_tests(both, out), 0);
   EXPECT_NE(out.str().find("acrylic/uninflated"), std::string::npos) << out.str();
   EXPECT_NE(out.str().find("wood/inflated"), std::string::npos) << out.str();
   std::ifstream summary(dir / "out" / "pull_summary.json");
@@ -112,10 +124,19 @@ TEST(CalibrationPull, ExportsRoundTripAndCommandGroupsBySurfaceAndFoot) {
   EXPECT_NE(text.str().find("\"tests\": 3"), std::string::npos) << text.str();
   EXPECT_TRUE(std::filesystem::exists(dir / "out" / "pull_tests.csv"));
 
-  EXPECT_THROW(pull_tests_main({(dir / "a").string()}, "", ignored), InputError);  // no weight
-  EXPECT_THROW(pull_tests_main({"--weight-N", "-1", (dir / "a").string()}, "", ignored), InputError);
-  EXPECT_THROW(pull_tests_main({"--weight-N", "1", "--bogus"}, "", ignored), InputError);
-  EXPECT_THROW(synth_pull_main({"--repeats", "2"}, ignored), InputError);  // no --out
+  // Unknown options are refused by the command line (tests/app/test_cli.cpp).
+  PullTestsOptions no_weight;
+  no_weight.inputs = {(dir / "a").string()};
+  EXPECT_THROW(analyse_pull_tests(no_weight, ignored), InputError);
+  PullTestsOptions negative = no_weight;
+  negative.weight_N = -1;
+  EXPECT_THROW(analyse_pull_tests(negative, ignored), InputError);
+  PullTestsOptions no_input;
+  no_input.weight_N = 1;
+  EXPECT_THROW(analyse_pull_tests(no_input, ignored), InputError);
+  SyntheticPullSet nowhere;  // no --out
+  nowhere.repeats = 2;
+  EXPECT_THROW(write_synthetic_pulls(nowhere, ignored), InputError);
   std::filesystem::remove_all(dir);
 }
 
