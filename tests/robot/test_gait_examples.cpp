@@ -18,14 +18,12 @@
 namespace morphfem {
 namespace {
 
-struct GaitExample {
-  std::string name;
-  double sign;  // of the gait's speed along its heading (roll_hill15 tumbles down the hill)
-};
-
-const std::vector<GaitExample>& gait_examples() {
-  static const std::vector<GaitExample> examples = {
-      {"roll_flat", +1}, {"roll_hill15", -1}, {"inch_flat", +1}, {"inch_hill15", +1}};
+// Every gait's first push or stroke moves the body forward along its heading (uphill on
+// the hill): measured at this level 3.7 mm (roll_flat), 46 mm (roll_hill15, which later
+// tumbles back down the hill: -0.77 BL/s over the gait), 29 mm (inch_flat) and 17 mm
+// (inch_hill15) in the first column.
+const std::vector<std::string>& gait_examples() {
+  static const std::vector<std::string> examples = {"roll_flat", "roll_hill15", "inch_flat", "inch_hill15"};
   return examples;
 }
 
@@ -36,12 +34,12 @@ std::string example_path(const std::string& name) {
 TEST(GaitExamples, AreTheScenesTheirCasesRun) {
   const RobotFidelity& level = find_robot_fidelity("0.02:2:0.1");
   const auto cases = preset_cases("lattice-mechanics", {"lattice-mechanics"});
-  for (const auto& example : gait_examples()) {
-    const YAML::Node generated = robot_scene_yaml(find_case(cases, example.name), level, "results/" + example.name);
-    const YAML::Node file = load_scene_yaml(example_path(example.name));
+  for (const auto& name : gait_examples()) {
+    const YAML::Node generated = robot_scene_yaml(find_case(cases, name), level, "results/" + name);
+    const YAML::Node file = load_scene_yaml(example_path(name));
     EXPECT_EQ(YAML::Dump(file), YAML::Dump(generated))
-        << example.name << ": rewrite it with morphfem robot scene --case " << example.name
-        << " --preset lattice-mechanics --fidelity 0.02:2:0.1 --out examples/gaits/" << example.name << ".yaml";
+        << name << ": rewrite it with morphfem robot scene --case " << name
+        << " --preset lattice-mechanics --fidelity 0.02:2:0.1 --out examples/gaits/" << name << ".yaml";
   }
 }
 
@@ -57,19 +55,24 @@ double displacement_along_heading(const Scene& scene, const SimulationResult& r)
   return end - start;
 }
 
-TEST(GaitExamples, FirstColumnMovesTheWayTheGaitDoes) {
-  for (const auto& example : gait_examples()) {
-    YAML::Node doc = load_scene_yaml(example_path(example.name));
-    const double first_column_end =
-        doc["actuation"]["start"].as<double>() + doc["actuation"]["schedule"]["column_s"].as<double>();
-    set_scene_key(doc, "solver.end_time=" + std::to_string(first_column_end), "test");
-    const Scene scene = scene_from_yaml(doc, example_path(example.name));
-    const SimulationResult r = run_scene(scene, PETSC_COMM_WORLD, RunOptions(false, false));
-    ASSERT_TRUE(r.stats.completed) << example.name << ": " << r.stats.failure;
-    const double moved = displacement_along_heading(scene, r);
-    EXPECT_GT(example.sign * moved, 1e-3) << example.name << " moved " << moved << " m along its heading";
-  }
+class GaitExample : public ::testing::TestWithParam<std::string> {};
+
+// The example itself, run to the end of its first column (2.74 s of 21.3 s).
+TEST_P(GaitExample, FirstColumnMovesForward) {
+  const std::string& name = GetParam();
+  YAML::Node doc = load_scene_yaml(example_path(name));
+  const double first_column_end =
+      doc["actuation"]["start"].as<double>() + doc["actuation"]["schedule"]["column_s"].as<double>();
+  set_scene_key(doc, "solver.end_time=" + std::to_string(first_column_end), "test");
+  const Scene scene = scene_from_yaml(doc, example_path(name));
+  const SimulationResult r = run_scene(scene, PETSC_COMM_WORLD, RunOptions(false, false));
+  ASSERT_TRUE(r.stats.completed) << name << ": " << r.stats.failure;
+  const double moved = displacement_along_heading(scene, r);
+  EXPECT_GT(moved, 1e-3) << name << " moved " << moved << " m along its heading in its first column";
 }
+
+INSTANTIATE_TEST_SUITE_P(Examples, GaitExample, ::testing::ValuesIn(gait_examples()),
+                         [](const auto& info) { return info.param; });
 
 }  // namespace
 }  // namespace morphfem
