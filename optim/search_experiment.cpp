@@ -135,6 +135,27 @@ class SearchRunner {
 
   ExperimentResult run(const ExperimentSpec& spec, const std::string& method_name);
   std::vector<HandDesignedResult> hand_designed(const std::vector<Environment>& envs);
+
+ private:
+  // One experiment of one method while it runs: its result so far, the method, the
+  // checkpoint's metadata and state, the progress bar and this session's counters.
+  struct Run {
+    ExperimentResult r;
+    std::unique_ptr<SearchMethod> method;
+    SearchState meta, state;
+    std::string checkpoint;
+    double resumed_evaluations = 0;
+    long evaluations_before = 0;
+    double wall_before = 0;
+    std::chrono::steady_clock::time_point session_start;
+  };
+  void open(Run& run, const ExperimentSpec& spec, const std::string& method_name);
+  void save(Run& run);
+  void step(Run& run, const ExperimentSpec& spec, Progress& progress);
+  void validate_best(Run& run, const ExperimentSpec& spec);
+  void write_results(const Run& run, const ExperimentSpec& spec) const;
+
+ public:
   const EvaluationTeams& teams() const { return teams_; }
   double wall_s() const { return wall_s_; }
   long evaluations() const { return evaluations_; }
@@ -148,135 +169,154 @@ class SearchRunner {
   long evaluations_ = 0;
 };
 
-ExperimentResult SearchRunner::run(const ExperimentSpec& spec, const std::string& method_name) {
-  ExperimentResult r;
+// The result's folder, the method, and the state of an earlier session's checkpoint
+// (every rank reads the same file: the same state everywhere).
+void SearchRunner::open(Run& run, const ExperimentSpec& spec, const std::string& method_name) {
+  ExperimentResult& r = run.r;
   r.experiment = spec.name;
   r.method = method_name;
   r.climbers = o_.climbers;
   r.generations = o_.generations;
   r.dir = o_.out_dir + "/" + spec.name + "/" + method_name;
   r.csv = r.dir + "/" + spec.name + ".csv";
-  const std::string checkpoint = r.dir + "/checkpoint.h5";
+  run.checkpoint = r.dir + "/checkpoint.h5";
 
   SearchSetup setup;
   setup.space = spec.space;
   setup.runs = o_.climbers;
   setup.generations = o_.generations;
   setup.seed = o_.seed;
-  auto method = make_search_method(method_name, setup);
+  run.method = make_search_method(method_name, setup);
 
-  const SearchState meta = search_metadata(spec, method_name, o_);
+  run.meta = search_metadata(spec, method_name, o_);
   if (root_) {
     std::filesystem::create_directories(r.dir);
     if (o_.restart) {
-      std::filesystem::remove(checkpoint);
+      std::filesystem::remove(run.checkpoint);
       remove_partial_steps(r.dir);
     }
   }
   MPI_Barrier(teams_.world());
-  SearchState state;
-  if (std::filesystem::exists(checkpoint)) {  // every rank reads the same file: same state everywhere
-    state = read_checkpoint(checkpoint);
-    check_metadata(state, meta, checkpoint);
-    method->restore(state, checkpoint);
+  if (std::filesystem::exists(run.checkpoint)) {
+    run.state = read_checkpoint(run.checkpoint);
+    check_metadata(run.state, run.meta, run.checkpoint);
+    run.method->restore(run.state, run.checkpoint);
     r.resumed = true;
   }
+}
 
+// After a step: its checkpoint, then (the checkpoint holds the whole step) its saved
+// evaluations are removed, then the CSV. A CSV row thus means no partial file of that
+// step is left.
+void SearchRunner::save(Run& run) {
+  run.state = run.meta;
+  run.method->save(run.state);
+  if (root_) {
+    write_checkpoint(run.checkpoint, run.state);
+    remove_partial_steps(run.r.dir);
+    write_file_atomic(run.r.csv, history_csv(run.method->history()));
+  }
+}
+
+// One step of the method (a generation, an iteration): propose, evaluate (reusing the
+// evaluations of this step a killed session saved, optim/search_partial.h), accept, save.
+void SearchRunner::step(Run& run, const ExperimentSpec& spec, Progress& progress) {
+  ExperimentResult& r = run.r;
+  SearchMethod& method = *run.method;
+  const std::vector<Genome> genomes = method.propose();
+  // Every rank reads the same files before any team leader rewrites its own.
+  const long step = method.steps();
+  const PartialSteps partial = read_partial_steps(r.dir, run.meta, step, genomes);
+  MPI_Barrier(teams_.world());
+  if (!partial.speeds.empty()) {
+    r.evaluations_reused += static_cast<long>(partial.speeds.size());
+    r.resumed = true;
+    run.resumed_evaluations += static_cast<double>(partial.speeds.size());
+    progress.set_resumed_from(run.resumed_evaluations);
+    if (root_ && o_.progress)
+      std::fprintf(stderr, "search %s/%s: %zu evaluation(s) of step %ld reused from %s/partial_team_*.h5\n",
+                   spec.name.c_str(), r.method.c_str(), partial.speeds.size(), step, r.dir.c_str());
+  }
+  BatchSpeeds saved = partial.speeds;  // this team's partial file: the reused speeds and its own
+  const std::string partial_file = partial_step_path(r.dir, teams_.team());
+  auto on_result = [&](std::size_t i, double v) {
+    saved[i] = v;
+    write_partial_step(partial_file, run.meta, step, genomes, saved);
+  };
+  const double done_before =
+      static_cast<double>(method.evaluations()) * o_.climbers + static_cast<double>(partial.speeds.size());
+  // Progress: generation, best so far, evaluations per hour of this session, ETA (core/progress.h).
+  auto on_done = [&](long k) {
+    const double session = static_cast<double>(evaluations_ - run.evaluations_before + k);
+    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - run.session_start).count();
+    const auto& h = method.history();
+    char info[160];
+    std::snprintf(info, sizeof info, "gen %ld/%d best %s BL/s %.3g evals/h", method.evaluations(), o_.generations,
+                  h.empty() ? "-" : fixed(max_of(h.back())).c_str(), elapsed > 0 ? 3600.0 * session / elapsed : 0.0);
+    progress.update(done_before + k, info);
+  };
+  const std::vector<double> speeds = evaluate(genomes, spec.env, o_.fidelity, on_done, partial.speeds, on_result);
+  method.accept(speeds);
+  save(run);
+  MPI_Barrier(teams_.world());  // the step's partial files are gone before any rank looks for the next step's
+}
+
+// Every climber's final best re-evaluated at the validation level (kept in the
+// checkpoint, so a resumed run does not redo it), and the rank correlations.
+void SearchRunner::validate_best(Run& run, const ExperimentSpec& spec) {
+  ExperimentResult& r = run.r;
+  auto it = run.state.texts.find("validate_fidelity");
+  if (it != run.state.texts.end() && it->second == o_.validate_fidelity) {
+    r.validation_speed = run.state.array("validation_speeds", run.checkpoint, o_.climbers);
+  } else {
+    r.validation_speed = evaluate(r.best, spec.env, o_.validate_fidelity);
+    run.state.texts["validate_fidelity"] = o_.validate_fidelity;
+    run.state.arrays["validation_speeds"] = r.validation_speed;
+    if (root_) write_checkpoint(run.checkpoint, run.state);
+  }
+  r.spearman = spearman_rho(r.best_speed, r.validation_speed);
+  r.kendall = kendall_tau(r.best_speed, r.validation_speed);
+}
+
+// The history CSV, each climber's best as a schedule file, the validation CSV.
+void SearchRunner::write_results(const Run& run, const ExperimentSpec& spec) const {
+  const ExperimentResult& r = run.r;
+  write_file_atomic(r.csv, history_csv(r.history));
+  std::filesystem::create_directories(r.dir + "/best");
+  for (int c = 0; c < o_.climbers; ++c) {
+    char name[32];
+    std::snprintf(name, sizeof name, "climber_%02d", c + 1);
+    const std::string label = spec.name + " " + r.method + " " + name + " speed " + format_number(r.best_speed[c]) +
+                              " BL/s at fidelity " + o_.fidelity;
+    write_file_atomic(r.dir + "/best/" + name + ".yaml", genome_schedule_yaml(r.best[c], label));
+  }
+  if (!r.validation_speed.empty()) write_file_atomic(r.dir + "/validation.csv", validation_csv(r));
+}
+
+ExperimentResult SearchRunner::run(const ExperimentSpec& spec, const std::string& method_name) {
+  Run run;
+  open(run, spec, method_name);
   // The bar covers the whole run; its ETA extrapolates this session's rate only (a
   // resumed run starts part way, and reused evaluations of a step take no time).
-  double resumed_evaluations = static_cast<double>(method->evaluations()) * o_.climbers;
+  run.resumed_evaluations = static_cast<double>(run.method->evaluations()) * o_.climbers;
   const double total = static_cast<double>(o_.climbers) * (o_.generations + 1);
-  Progress progress("search " + spec.name + "/" + method_name, total, o_.progress && total > resumed_evaluations);
-  progress.set_resumed_from(resumed_evaluations);
-  const long evaluations_before = evaluations_;
-  const double wall_before = wall_s_;
-  // After a step: its checkpoint, then (the checkpoint holds the whole step) its saved
-  // evaluations are removed, then the CSV. A CSV row thus means no partial file of that step is left.
-  auto save = [&]() {
-    state = meta;
-    method->save(state);
-    if (root_) {
-      write_checkpoint(checkpoint, state);
-      remove_partial_steps(r.dir);
-      write_file_atomic(r.csv, history_csv(method->history()));
-    }
-  };
-  const auto session_start = std::chrono::steady_clock::now();
-  while (!method->done()) {
-    const std::vector<Genome> genomes = method->propose();
-    // Evaluations of this step that a killed session saved are reused, not redone
-    // (optim/search_partial.h); every rank reads the same files before any team
-    // leader rewrites its own.
-    const long step = method->steps();
-    const PartialSteps partial = read_partial_steps(r.dir, meta, step, genomes);
-    MPI_Barrier(teams_.world());
-    if (!partial.speeds.empty()) {
-      r.evaluations_reused += static_cast<long>(partial.speeds.size());
-      r.resumed = true;
-      resumed_evaluations += static_cast<double>(partial.speeds.size());
-      progress.set_resumed_from(resumed_evaluations);
-      if (root_ && o_.progress)
-        std::fprintf(stderr, "search %s/%s: %zu evaluation(s) of step %ld reused from %s/partial_team_*.h5\n",
-                     spec.name.c_str(), method_name.c_str(), partial.speeds.size(), step, r.dir.c_str());
-    }
-    BatchSpeeds saved = partial.speeds;  // this team's partial file: the reused speeds and its own
-    const std::string partial_file = partial_step_path(r.dir, teams_.team());
-    auto on_result = [&](std::size_t i, double v) {
-      saved[i] = v;
-      write_partial_step(partial_file, meta, step, genomes, saved);
-    };
-    const double done_before =
-        static_cast<double>(method->evaluations()) * o_.climbers + static_cast<double>(partial.speeds.size());
-    // Progress: generation, best so far, evaluations per hour of this session, ETA (core/progress.h).
-    auto on_done = [&](long k) {
-      const double session = static_cast<double>(evaluations_ - evaluations_before + k);
-      const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - session_start).count();
-      const auto& h = method->history();
-      char info[160];
-      std::snprintf(info, sizeof info, "gen %ld/%d best %s BL/s %.3g evals/h", method->evaluations(), o_.generations,
-                    h.empty() ? "-" : fixed(max_of(h.back())).c_str(), elapsed > 0 ? 3600.0 * session / elapsed : 0.0);
-      progress.update(done_before + k, info);
-    };
-    const std::vector<double> speeds = evaluate(genomes, spec.env, o_.fidelity, on_done, partial.speeds, on_result);
-    method->accept(speeds);
-    save();
-    MPI_Barrier(teams_.world());  // the step's partial files are gone before any rank looks for the next step's
-  }
-  progress.finish("best " + fixed(max_of(method->best_speeds())) + " BL/s");
-  r.evaluations_timed = evaluations_ - evaluations_before;
-  r.evaluation_wall_s = wall_s_ - wall_before;
+  Progress progress("search " + spec.name + "/" + method_name, total, o_.progress && total > run.resumed_evaluations);
+  progress.set_resumed_from(run.resumed_evaluations);
+  run.evaluations_before = evaluations_;
+  run.wall_before = wall_s_;
+  run.session_start = std::chrono::steady_clock::now();
+  while (!run.method->done()) step(run, spec, progress);
+  progress.finish("best " + fixed(max_of(run.method->best_speeds())) + " BL/s");
 
-  r.history = method->history();
-  r.best = method->best_genomes();
-  r.best_speed = method->best_speeds();
+  ExperimentResult& r = run.r;
+  r.evaluations_timed = evaluations_ - run.evaluations_before;
+  r.evaluation_wall_s = wall_s_ - run.wall_before;
+  r.history = run.method->history();
+  r.best = run.method->best_genomes();
+  r.best_speed = run.method->best_speeds();
   r.evaluations = static_cast<long>(r.history.size()) * o_.climbers;
-
-  if (!o_.validate_fidelity.empty()) {
-    auto it = state.texts.find("validate_fidelity");
-    if (it != state.texts.end() && it->second == o_.validate_fidelity) {
-      r.validation_speed = state.array("validation_speeds", checkpoint, o_.climbers);
-    } else {
-      r.validation_speed = evaluate(r.best, spec.env, o_.validate_fidelity);
-      state.texts["validate_fidelity"] = o_.validate_fidelity;
-      state.arrays["validation_speeds"] = r.validation_speed;
-      if (root_) write_checkpoint(checkpoint, state);
-    }
-    r.spearman = spearman_rho(r.best_speed, r.validation_speed);
-    r.kendall = kendall_tau(r.best_speed, r.validation_speed);
-  }
-
-  if (root_) {
-    write_file_atomic(r.csv, history_csv(r.history));
-    std::filesystem::create_directories(r.dir + "/best");
-    for (int c = 0; c < o_.climbers; ++c) {
-      char name[32];
-      std::snprintf(name, sizeof name, "climber_%02d", c + 1);
-      const std::string label = spec.name + " " + method_name + " " + name + " speed " +
-                                format_number(r.best_speed[c]) + " BL/s at fidelity " + o_.fidelity;
-      write_file_atomic(r.dir + "/best/" + name + ".yaml", genome_schedule_yaml(r.best[c], label));
-    }
-    if (!r.validation_speed.empty()) write_file_atomic(r.dir + "/validation.csv", validation_csv(r));
-  }
+  if (!o_.validate_fidelity.empty()) validate_best(run, spec);
+  if (root_) write_results(run, spec);
   return r;
 }
 
