@@ -1,4 +1,4 @@
-// Morphing calibration (issue 8): the times the core's valve takes to turn the flat
+// Morphing calibration: the times the core's valve takes to turn the flat
 // robot into a cylinder and back, and the shapes it reaches.
 //
 // A morph run feeds the core from the line (supply gauge pressure p_s > 0) from

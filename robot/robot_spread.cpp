@@ -2,7 +2,7 @@
 //
 // Some gaits are chaotic: the robot tumbling down the 15 deg hill comes to rest on
 // one bladder or another, and a 1 % change of the mesh or the time step moves its
-// speed by a factor of two (README, "roll_hill15 ladder"). One run per fidelity level
+// speed by a factor of two (docs/validation.md, "Rolling down the 15 deg hill"). One run per fidelity level
 // is then a sample, not a measurement, and a ladder of single runs cannot say which
 // level is converged. This command runs the case once per value of one scene key (the
 // perturbation: the heading on the hill, the time step, the column length, ...), on

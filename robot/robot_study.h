@@ -82,8 +82,8 @@ std::vector<RobotCase> voxel_baseline_cases(const std::string& source_dir);
 std::vector<RobotCase> physical_baseline_cases(const std::string& source_dir);
 
 // The voxel-study preset with the lattice's own mechanics, as scene keys set after
-// the case's (preset "lattice-mechanics" of `robot validate`; README "With the
-// lattice's floor contact and stiff bladders"):
+// the case's (preset "lattice-mechanics" of `robot validate`; docs/validation.md, "With the
+// lattice's floor contact and stiff bladders the slice rolls"):
 //   contact.lattice_floor   each of the lattice's 1,428 voxels touches the floor as a
 //                           sphere (Voxelyze's floor contact) instead of the faces,
 //                           skin mu 2.0, bladders 2/3, feet from the schedule;

@@ -5,7 +5,7 @@ Prints, per saved step, the centroid (x, z) and the angle of the seam-to-seam
 vector of the mid-length cross-section (the nodes within 6 cm of mid-length and
 1.1 cm of either long edge x = min / max in the reference): 0 deg when the body
 lies flat, negative when it has rolled towards +x. Used to tell rolling from
-rocking in the roll_flat diagnostics (README).
+rocking in the roll_flat diagnostics (docs/validation.md).
 
 With --chambers it prints instead, per step, where each chamber (the volume regions
 named bladder_K, from the result's region names) is: its angle about the centroid of

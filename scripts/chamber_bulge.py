@@ -9,7 +9,7 @@ cross-section; for a 3D body, --band B takes only the nodes within B of the mesh
 mid-length (y); theta = acos(R / (R + h))
 is how far a rigid cylinder of radius R turns when lifted by that bump at its contact.
 A push of the rolling schedule advances the wave only if theta > 45 deg (h > 0.41 R;
-README, "Rolling the physical laminate"). The axis is the mean of the skin nodes.
+docs/physical-robot.md, "Rolling"). The axis is the mean of the skin nodes.
 Region ids follow the mesh's volume order: robot_physical has skin 0, fabric 1,
 bladder_1..8 = 2..9 (default 9: bladder_8, the first chamber of the rolling schedule);
 with `fabric: membrane` there is no fabric volume and bladder_8 is 8.

@@ -15,7 +15,7 @@ After `--start` (the end of settling) it prints
 With --steps it first prints, per saved step after `--start`, each foot's friction force
 along y [N] and normal force [N] and the force on the rest of the body, so one sees which
 foot anchors in which column.
-Used for the physical inching ladder in the README, and (--foot 0.03 --pad 0.0041
+Used for the physical inching ladder in docs/physical-robot.md, and (--foot 0.03 --pad 0.0041
 --steps: the voxel preset's feet are the bottom skin layer's ends at z = 4 mm) for the
 voxel preset's feet.
 

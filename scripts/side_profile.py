@@ -12,7 +12,7 @@ arc's end-to-end turn (-164 deg for a half circle with 11 bins). Per saved step 
 t, the curl [deg], the highest skin point [mm] and the distance between the end slices
 [mm]; then the largest curl. With --png FILE it also draws the side views (y against z;
 skin and the other regions in two colours) at the --at times (nearest saved steps).
-Used for the inching P2 check in the README (the lattice's growth curls a
+Used for the inching P2 check in docs/validation.md (the lattice's growth curls a
 non-locking body into a ring).
 
     /usr/bin/python3 scripts/side_profile.py RESULTS/CASE.h5 [--start 1.5] [--end T] [--every 1]

@@ -436,7 +436,7 @@ void slope_case(const VerifyOptions& opt, MPI_Comm comm, std::vector<Verificatio
   }
 }
 
-// ------------------------------- friction that switches on a schedule (issue 4)
+// ------------------------------- friction that switches on a schedule
 // A block on a slope atan(0.5): mu = 0.9 (sticks) until t = 1 s, 0.2 (slides,
 // a1 = g (sin - 0.2 cos)) until t = 2 s, then 0.9 again (decelerates with
 // a2 = g (sin - 0.9 cos) < 0 until it stops). Exact slide:

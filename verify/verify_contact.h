@@ -1,4 +1,4 @@
-// Contact verification cases (issue 4; ../shared/VERIFICATION.md cases 9 and 10),
+// Contact verification cases (../shared/VERIFICATION.md cases 9 and 10),
 // each on a ladder of mesh and time-step levels, appending VerificationRecord's
 // (value, reference, rel_error, cost) like every other case.
 #pragma once

@@ -67,7 +67,7 @@ class OctantShell {
     partition_ = partition_mesh(mesh_, size);
     std::vector<std::shared_ptr<const Material>> materials(mesh_.regions.size());
     materials[mesh_.region("body", 3).id] = make_material(material);
-    // Locking-free formulation for P2 if registered (issue 3, part 1), else displacement.
+    // Locking-free formulation for P2 if registered, else displacement.
     formulation_ = order == 2 && elastic_formulations().count("mean_dilatation") ? "mean_dilatation" : "displacement";
     elastic_ = elastic_formulations().at(formulation_)(mesh_, partition_, rank_, materials, 0);
     assembler_ = std::make_unique<Assembler>(mesh_, partition_, comm);

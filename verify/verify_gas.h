@@ -1,5 +1,5 @@
 // Hard verification cases for gas-filled and volume-controlled cavities
-// (../shared/VERIFICATION.md cases 3 and 5, issue 3): limit points of inflated
+// (../shared/VERIFICATION.md cases 3 and 5): limit points of inflated
 // spheres and balloons traced with volume control, graceful failure of pressure
 // control past a limit point, and the valve model's fill times. Built with the
 // lower-level API (octant meshes, Assembler, QuasiStaticSolver) because scenes

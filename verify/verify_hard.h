@@ -1,4 +1,4 @@
-// Hard verification cases (`morphfem verify --hard`, issue 3): near-incompressibility,
+// Hard verification cases (`morphfem verify --hard`): near-incompressibility,
 // extreme compression and large rotations. Each appends VerificationRecord's with
 // their cost (Newton iterations, step cuts, wall time); references from
 // ../shared/VERIFICATION.md or closed forms stated in verify_hard.cpp.

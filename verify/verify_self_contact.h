@@ -1,4 +1,4 @@
-// Verification case 11 (../shared/VERIFICATION.md, issue 4): a flat tube
+// Verification case 11 (../shared/VERIFICATION.md): a flat tube
 // flattened by cavity vacuum until its inner faces meet and press on each other.
 //
 // Geometry (plane strain, half by symmetry x = 0): a slab |z| <= g/2 + t,

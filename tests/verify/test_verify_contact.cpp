@@ -1,4 +1,4 @@
-// Contact verification cases (issue 4, VERIFICATION.md cases 9 and 10) at their
+// Contact verification cases (VERIFICATION.md cases 9 and 10) at their
 // quick level, against the bounds the issue states, and their building blocks.
 #include <gtest/gtest.h>
 #include <petscsys.h>

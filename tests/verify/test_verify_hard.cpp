@@ -1,4 +1,4 @@
-// Quick runs of the hard cases (issue 3) and the mean-dilatation formulation inside
+// Quick runs of the hard cases and the mean-dilatation formulation inside
 // full solves: patch test, agreement with the displacement element at moderate
 // kappa, Cook's membrane (locking vs locking-free) and the end-moment cantilever.
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// Self-contact through the solver and the scene (issue 4, VERIFICATION.md case 11):
+// Self-contact through the solver and the scene (VERIFICATION.md case 11):
 // the candidate refresh between steps (SelfContactTerm::refresh_pieces and the
 // solver's pattern rebuild), the scene key contact.self and its input errors, the
 // brute-force distance check of the verification, and the quick tube-vacuum level:
