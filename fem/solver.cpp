@@ -329,6 +329,25 @@ double QuasiStaticSolver::admissible_step(Vec u, Vec du, std::string* limiter) {
   return alpha;
 }
 
+// -morphfem_linesearch_monitor: the admissible step, the term that bounds it, and
+// the accepted step (diagnosing stagnating Newton iterations); after a backtrack,
+// which terms' energies rose over the largest step. W is left at X - lambda Y.
+PetscErrorCode QuasiStaticSolver::print_line_search(Vec X, Vec Y, Vec W, double lambda_max, const std::string& limiter,
+                                                    double lambda, bool accepted, double slope) {
+  PetscCall(PetscPrintf(assembler_.comm(), "      line search: max step %.3e (%s), %s %.3e, slope %.3e, %s Hessian\n",
+                        lambda_max, limiter.c_str(), accepted ? "accepted" : "rejected down to", lambda, slope,
+                        exact_hessian_ ? "exact" : "projected"));
+  if (!(lambda < lambda_max)) return 0;
+  const std::vector<double> before = assembler_.term_energies(X);
+  PetscCall(VecWAXPY(W, -lambda_max, Y, X));
+  const std::vector<double> after = assembler_.term_energies(W);
+  for (size_t k = 0; k < before.size(); ++k)
+    PetscCall(PetscPrintf(assembler_.comm(), "        %-24s dE %+.3e at the max step\n",
+                          assembler_.terms()[k]->name().c_str(), after[k] - before[k]));
+  PetscCall(VecWAXPY(W, -lambda, Y, X));  // the accepted state, as before
+  return 0;
+}
+
 // Energy-based backtracking (Armijo) along the Newton direction: W = X - lambda Y.
 // Rejects states with infinite energy (outside the domain); if the direction is
 // not a descent direction (indefinite Hessian), falls back to steepest descent.
@@ -410,22 +429,7 @@ PetscErrorCode QuasiStaticSolver::line_search(SNESLineSearch ls) {
     PetscCall(reproject());
   }
   if (opt_.newton_velocity_tol > 0) direction_max_ = newton_direction ? largest_nodal_norm(Y) : 1e300;
-  // -morphfem_linesearch_monitor: the admissible step, the term that bounds it, and
-  // the accepted step (diagnosing stagnating Newton iterations).
-  if (linesearch_monitor_) {
-    PetscCall(PetscPrintf(assembler_.comm(), "      line search: max step %.3e (%s), %s %.3e, slope %.3e, %s Hessian\n",
-                          lambda_max, limiter.c_str(), accepted ? "accepted" : "rejected down to", lambda, slope,
-                          exact_hessian_ ? "exact" : "projected"));
-    if (lambda < lambda_max) {  // backtracked: which terms' energies rose over the largest step
-      const std::vector<double> before = assembler_.term_energies(X);
-      PetscCall(VecWAXPY(W, -lambda_max, Y, X));
-      const std::vector<double> after = assembler_.term_energies(W);
-      for (size_t k = 0; k < before.size(); ++k)
-        PetscCall(PetscPrintf(assembler_.comm(), "        %-24s dE %+.3e at the max step\n",
-                              assembler_.terms()[k]->name().c_str(), after[k] - before[k]));
-      PetscCall(VecWAXPY(W, -lambda, Y, X));  // the accepted state, as before
-    }
-  }
+  if (linesearch_monitor_) PetscCall(print_line_search(X, Y, W, lambda_max, limiter, lambda, accepted, slope));
   if (!accepted) {
     PetscCall(SNESLineSearchSetReason(ls, SNES_LINESEARCH_FAILED_REDUCT));
     return 0;

@@ -137,6 +137,8 @@ class QuasiStaticSolver {
   // (EnergyTerm::max_step); `limiter` (optional) names the term that bounds it.
   double admissible_step(Vec u, Vec du, std::string* limiter);
   double largest_nodal_norm(Vec v) const;
+  PetscErrorCode print_line_search(Vec X, Vec Y, Vec W, double lambda_max, const std::string& limiter, double lambda,
+                                   bool accepted, double slope);
   std::vector<PetscLogEvent> max_step_events_;  // "MaxStep:NAME" per term
 
   Assembler& assembler_;
