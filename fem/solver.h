@@ -9,6 +9,10 @@
 // indefinite); "mumps_lu" selects MUMPS LU, "gamg" CG + GAMG with the rigid-body
 // near-nullspace. Any PETSc option (-snes_*, -ksp_*, -pc_*) on the command line
 // overrides these defaults.
+//
+// Diagnostics: -morphfem_step_monitor prints a line per step (t, dt, Newton
+// iterations, the next dt) and per cut (its cause); -morphfem_linesearch_monitor
+// one per line search. Where the time goes: -log_view (events in fem/profile.h).
 #pragma once
 #include <petscsnes.h>
 
