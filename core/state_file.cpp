@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "core/errors.h"
+#include "core/log_event.h"
 
 namespace morphfem {
 
@@ -139,6 +140,7 @@ herr_t read_dataset(hid_t loc, const char* name, const H5L_info_t*, void* data) 
 }  // namespace
 
 void write_state_file(const std::string& path, const StateRecord& record) {
+  LogEventScope scope("StateFileWrite");
   const std::string tmp = path + ".tmp";
   {
     QuietHdf5 quiet;

@@ -8,6 +8,7 @@
 #include <stdexcept>
 #include <unordered_map>
 
+#include "core/log_event.h"
 #include "fem/petsc_check.h"
 
 namespace morphfem {
@@ -24,7 +25,11 @@ Assembler::~Assembler() {
   if (scatter_) VecScatterDestroy(&scatter_);
 }
 
-void Assembler::add_term(std::shared_ptr<EnergyTerm> term) { terms_.push_back(std::move(term)); }
+void Assembler::add_term(std::shared_ptr<EnergyTerm> term) {
+  const std::string name = term->name();
+  term_events_.push_back({log_event("E:" + name), log_event("G:" + name), log_event("H:" + name)});
+  terms_.push_back(std::move(term));
+}
 
 void Assembler::set_constrained(const std::vector<int>& dofs) {
   std::fill(constrained_.begin(), constrained_.end(), 0);
@@ -191,7 +196,9 @@ double Assembler::sweep(Vec u, bool want_g, bool want_H, Visit&& visit) {
   Eigen::VectorXd g;
   Eigen::MatrixXd H;
   double local = 0.0;
+  const int kind = want_H ? 2 : want_g ? 1 : 0;  // the term's event: E:, G: or H:
   for (size_t t = 0; t < terms_.size(); ++t) {
+    LogEventScope event(term_events_[t][kind]);
     EnergyTerm& term = *terms_[t];
     term.prepare(*this, ghost_u_);
     for (int k = 0; k < term.n_pieces(); ++k) {
@@ -211,6 +218,8 @@ double Assembler::sweep(Vec u, bool want_g, bool want_H, Visit&& visit) {
 }
 
 double Assembler::energy(Vec u) {
+  static const PetscLogEvent event = log_event("AsmEnergy");
+  LogEventScope scope(event);
   return sweep(u, false, false, [](auto&&...) {});
 }
 
@@ -222,6 +231,8 @@ std::vector<double> Assembler::term_energies(Vec u) {
 }
 
 double Assembler::gradient(Vec u, Vec gvec) {
+  static const PetscLogEvent event = log_event("AsmGradient");
+  LogEventScope scope(event);
   PETSC_CHECK(VecSet(gvec, 0.0));
   // Constrained dofs carry index -1; PETSc vectors skip them only with this option.
   PETSC_CHECK(VecSetOption(gvec, VEC_IGNORE_NEGATIVE_INDICES, PETSC_TRUE));
@@ -239,6 +250,8 @@ double Assembler::gradient(Vec u, Vec gvec) {
 }
 
 void Assembler::hessian(Vec u, Mat Hmat) {
+  static const PetscLogEvent event = log_event("AsmHessian");
+  LogEventScope scope(event);
   // Values go into the coordinate list built by setup() and reach PETSc in one
   // MatSetValuesCOO: measured on the voxel robot (3,060 dofs, P1), per-piece
   // MatSetValues took ~40 % of the run, most of it searching for columns.

@@ -13,6 +13,7 @@
 #include <petscmat.h>
 #include <petscvec.h>
 
+#include <array>
 #include <memory>
 #include <utility>
 #include <vector>
@@ -82,6 +83,9 @@ class Assembler {
   MPI_Comm comm_;
   int rank_ = 0;
   std::vector<std::shared_ptr<EnergyTerm>> terms_;
+  // Log events of each term's sweeps (core/log_event.h): energy "E:NAME", gradient
+  // "G:NAME", Hessian "H:NAME"; the whole sweeps are AsmEnergy, AsmGradient, AsmHessian.
+  std::vector<std::array<PetscLogEvent, 3>> term_events_;
   std::vector<char> constrained_;  // per global dof
   std::vector<int> slot_;          // global node -> slot in ghost array (-1)
   std::vector<int> ghost_nodes_;   // nodes needed on this rank, sorted

@@ -13,6 +13,7 @@
 #include <system_error>
 
 #include "core/json.h"
+#include "core/log_event.h"
 
 // XDMF dialect. We write `<Xdmf Version="2.0">`: every ParaView reader for .xdmf
 // (the legacy "Xdmf Reader" and "Xdmf3 Reader S/T") reads version-2 files, while
@@ -458,6 +459,7 @@ void ResultWriter::close() {
 }
 
 void ResultWriter::write_step(double time, const std::vector<Field>& nodal, const std::vector<Field>& cell) {
+  LogEventScope scope("OutputStep");
   const std::string label = step_label(steps_);
   const std::string where = "ResultWriter: step " + std::to_string(steps_) + " (t=" + number(time) + ")";
   if (file_ < 0) throw std::runtime_error(where + ": writer is closed");
@@ -597,6 +599,7 @@ void ResultWriter::write_xdmf() const {
 
 void ResultWriter::append_row(const std::string& table, const std::vector<std::string>& columns,
                               const std::vector<double>& row) {
+  LogEventScope scope("OutputRow");
   const std::string where = "ResultWriter: table '" + table + "'";
   if (file_ < 0) throw std::runtime_error(where + ": writer is closed");
   check_name(table, "table");

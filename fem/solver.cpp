@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "core/errors.h"
+#include "core/log_event.h"
 #include "fem/petsc_check.h"
 #include "fem/term_state.h"
 
@@ -53,6 +54,12 @@ PetscErrorCode convergence_trampoline(SNES snes, PetscInt it, PetscReal, PetscRe
 QuasiStaticSolver::QuasiStaticSolver(Assembler& assembler, std::vector<DirichletCondition> bcs, SolverOptions options)
     : assembler_(assembler), bcs_(std::move(bcs)), opt_(std::move(options)) {
   PETSC_CHECK(PetscOptionsGetBool(nullptr, nullptr, "-morphfem_linesearch_monitor", &linesearch_monitor_, nullptr));
+  PETSC_CHECK(PetscOptionsGetBool(nullptr, nullptr, "-morphfem_step_monitor", &step_monitor_, nullptr));
+  PETSC_CHECK(
+      PetscOptionsGetReal(nullptr, nullptr, "-morphfem_newton_velocity_tol", &opt_.newton_velocity_tol, nullptr));
+  PetscBool extrapolate = opt_.extrapolate ? PETSC_TRUE : PETSC_FALSE;
+  PETSC_CHECK(PetscOptionsGetBool(nullptr, nullptr, "-morphfem_extrapolate", &extrapolate, nullptr));
+  opt_.extrapolate = extrapolate;
   std::vector<int> dofs;
   for (const auto& bc : bcs_)
     for (int n : bc.nodes)
@@ -149,6 +156,8 @@ void QuasiStaticSolver::attach_near_nullspace() {
 // the new pattern and handed to SNES (the linear solver re-factors it anyway at
 // the next Newton iteration). Terms that never change keep everything as it was.
 void QuasiStaticSolver::refresh_pieces() {
+  static const PetscLogEvent event = log_event("RefreshPieces");
+  LogEventScope scope(event);
   int changed = 0;
   for (const auto& term : assembler_.terms()) changed |= term->refresh_pieces(assembler_, u_) ? 1 : 0;
   int any = 0;
@@ -159,6 +168,8 @@ void QuasiStaticSolver::refresh_pieces() {
 }
 
 void QuasiStaticSolver::rebuild_pattern() {
+  static const PetscLogEvent event = log_event("PatternRebuild");
+  LogEventScope scope(event);
   assembler_.setup();
   PETSC_CHECK(MatDestroy(&H_));
   H_ = assembler_.create_matrix();
@@ -167,6 +178,8 @@ void QuasiStaticSolver::rebuild_pattern() {
 }
 
 void QuasiStaticSolver::save_state(StateRecord& state) {
+  static const PetscLogEvent event = log_event("SolverSave");
+  LogEventScope scope(event);
   const RunStats& counters = counters_;
   save_vector(assembler_, u_, "solver.u", state);
   save_vector(assembler_, u_prev_, "solver.u_prev", state);
@@ -242,6 +255,8 @@ PetscErrorCode QuasiStaticSolver::jacobian(Vec u, Mat J, Mat P) {
     assembler_.hessian(u, P);
     for (const auto& term : assembler_.terms()) term->set_exact_hessian(false);
     if (J_) {
+      static const PetscLogEvent event = log_event("LowRank");
+      LogEventScope scope(event);
       clear_low_rank();
       for (const auto& term : assembler_.terms()) term->low_rank(assembler_, u, low_rank_);
     }
@@ -280,6 +295,59 @@ void QuasiStaticSolver::apply_dirichlet(Vec u, double t) const {
   PETSC_CHECK(VecRestoreArray(u, &a));
 }
 
+// max_a |v_a| over the nodes a (3 dofs each) of v (collective) [units of v].
+double QuasiStaticSolver::largest_nodal_norm(Vec v) const {
+  const PetscScalar* a;
+  PetscInt n = 0;
+  PETSC_CHECK(VecGetLocalSize(v, &n));
+  PETSC_CHECK(VecGetArrayRead(v, &a));
+  double local = 0.0;
+  for (PetscInt i = 0; i + 2 < n; i += 3)
+    local = std::max(local, std::sqrt(a[i] * a[i] + a[i + 1] * a[i + 1] + a[i + 2] * a[i + 2]));
+  PETSC_CHECK(VecRestoreArrayRead(v, &a));
+  double total = 0.0;
+  MPI_Allreduce(&local, &total, 1, MPI_DOUBLE, MPI_MAX, assembler_.comm());
+  return total;
+}
+
+double QuasiStaticSolver::admissible_step(Vec u, Vec du, std::string* limiter) {
+  const auto& terms = assembler_.terms();
+  if (max_step_events_.size() != terms.size()) {
+    max_step_events_.clear();
+    for (const auto& term : terms) max_step_events_.push_back(log_event("MaxStep:" + term->name()));
+  }
+  double alpha = 1.0;
+  if (limiter) *limiter = "none";
+  for (size_t k = 0; k < terms.size(); ++k) {
+    LogEventScope scope(max_step_events_[k]);
+    const double a = terms[k]->max_step(assembler_, u, du);
+    if (a < alpha) {
+      alpha = a;
+      if (limiter) *limiter = terms[k]->name();
+    }
+  }
+  return alpha;
+}
+
+// -morphfem_linesearch_monitor: the admissible step, the term that bounds it, and
+// the accepted step (diagnosing stagnating Newton iterations); after a backtrack,
+// which terms' energies rose over the largest step. W is left at X - lambda Y.
+PetscErrorCode QuasiStaticSolver::print_line_search(Vec X, Vec Y, Vec W, double lambda_max, const std::string& limiter,
+                                                    double lambda, bool accepted, double slope) {
+  PetscCall(PetscPrintf(assembler_.comm(), "      line search: max step %.3e (%s), %s %.3e, slope %.3e, %s Hessian\n",
+                        lambda_max, limiter.c_str(), accepted ? "accepted" : "rejected down to", lambda, slope,
+                        exact_hessian_ ? "exact" : "projected"));
+  if (!(lambda < lambda_max)) return 0;
+  const std::vector<double> before = assembler_.term_energies(X);
+  PetscCall(VecWAXPY(W, -lambda_max, Y, X));
+  const std::vector<double> after = assembler_.term_energies(W);
+  for (size_t k = 0; k < before.size(); ++k)
+    PetscCall(PetscPrintf(assembler_.comm(), "        %-24s dE %+.3e at the max step\n",
+                          assembler_.terms()[k]->name().c_str(), after[k] - before[k]));
+  PetscCall(VecWAXPY(W, -lambda, Y, X));  // the accepted state, as before
+  return 0;
+}
+
 // Energy-based backtracking (Armijo) along the Newton direction: W = X - lambda Y.
 // Rejects states with infinite energy (outside the domain); if the direction is
 // not a descent direction (indefinite Hessian), falls back to steepest descent.
@@ -288,12 +356,17 @@ PetscErrorCode QuasiStaticSolver::line_search(SNESLineSearch ls) {
   PetscCall(SNESLineSearchGetVecs(ls, &X, &F, &Y, &W, &G));
   SNES snes;
   PetscCall(SNESLineSearchGetSNES(ls, &snes));
-  const double e0 = assembler_.energy(X);
+  static const PetscLogEvent energy_event = log_event("LSEnergy"), reproject_event = log_event("LSReproject");
+  const double e0 = [&] {
+    LogEventScope scope(energy_event);
+    return assembler_.energy(X);
+  }();
   PetscReal fnorm_old;
   PetscCall(VecNorm(F, NORM_2, &fnorm_old));
   // Adaptive projection's fallback: re-solve for Y with the projected Hessian, which
   // is positive semi-definite (the exact one may be indefinite along Y).
   const auto reproject = [&]() -> PetscErrorCode {
+    LogEventScope scope(reproject_event);
     exact_hessian_ = false;
     ++projection_fallbacks_;
     Mat A, B;
@@ -308,7 +381,7 @@ PetscErrorCode QuasiStaticSolver::line_search(SNESLineSearch ls) {
   PetscReal slope;  // d/dlambda E(X - lambda Y) at 0 = -F.Y
   double lambda = 1.0, lambda_max = 1.0;
   std::string limiter = "none";
-  bool accepted = false;
+  bool accepted = false, newton_direction = true;
   for (;;) {
     PetscCall(VecDot(F, Y, &slope));
     slope = -slope;
@@ -317,6 +390,7 @@ PetscErrorCode QuasiStaticSolver::line_search(SNESLineSearch ls) {
       continue;
     }
     if (!(slope < 0)) {
+      newton_direction = false;  // steepest descent instead
       PetscReal ynorm;
       PetscCall(VecNorm(Y, NORM_2, &ynorm));
       PetscCall(VecCopy(F, Y));
@@ -324,17 +398,9 @@ PetscErrorCode QuasiStaticSolver::line_search(SNESLineSearch ls) {
       slope = -ynorm * fnorm_old;
     }
     // Largest admissible step along du = -Y (contact barriers, ...).
-    lambda = 1.0;
-    limiter = "none";
     PetscCall(VecCopy(Y, W));
     PetscCall(VecScale(W, -1.0));
-    for (const auto& term : assembler_.terms()) {
-      const double l = term->max_step(assembler_, X, W);
-      if (l < lambda) {
-        lambda = l;
-        limiter = term->name();
-      }
-    }
+    lambda = admissible_step(X, W, &limiter);
     if (!(lambda > 0)) {
       PetscCall(SNESLineSearchSetReason(ls, SNES_LINESEARCH_FAILED_DOMAIN));
       return 0;
@@ -342,6 +408,7 @@ PetscErrorCode QuasiStaticSolver::line_search(SNESLineSearch ls) {
     lambda_max = lambda;
     for (int attempt = 0; attempt < 40 && !accepted; ++attempt, lambda *= 0.5) {
       PetscCall(VecWAXPY(W, -lambda, Y, X));
+      LogEventScope scope(energy_event);
       const double e = assembler_.energy(W);
       if (!std::isfinite(e)) continue;
       const double noise = 1e-12 * std::max(1.0, std::abs(e0));
@@ -361,22 +428,8 @@ PetscErrorCode QuasiStaticSolver::line_search(SNESLineSearch ls) {
     if (accepted || !exact_hessian_) break;
     PetscCall(reproject());
   }
-  // -morphfem_linesearch_monitor: the admissible step, the term that bounds it, and
-  // the accepted step (diagnosing stagnating Newton iterations).
-  if (linesearch_monitor_) {
-    PetscCall(PetscPrintf(assembler_.comm(), "      line search: max step %.3e (%s), %s %.3e, slope %.3e, %s Hessian\n",
-                          lambda_max, limiter.c_str(), accepted ? "accepted" : "rejected down to", lambda, slope,
-                          exact_hessian_ ? "exact" : "projected"));
-    if (lambda < lambda_max) {  // backtracked: which terms' energies rose over the largest step
-      const std::vector<double> before = assembler_.term_energies(X);
-      PetscCall(VecWAXPY(W, -lambda_max, Y, X));
-      const std::vector<double> after = assembler_.term_energies(W);
-      for (size_t k = 0; k < before.size(); ++k)
-        PetscCall(PetscPrintf(assembler_.comm(), "        %-24s dE %+.3e at the max step\n",
-                              assembler_.terms()[k]->name().c_str(), after[k] - before[k]));
-      PetscCall(VecWAXPY(W, -lambda, Y, X));  // the accepted state, as before
-    }
-  }
+  if (opt_.newton_velocity_tol > 0) direction_max_ = newton_direction ? largest_nodal_norm(Y) : 1e300;
+  if (linesearch_monitor_) PetscCall(print_line_search(X, Y, W, lambda_max, limiter, lambda, accepted, slope));
   if (!accepted) {
     PetscCall(SNESLineSearchSetReason(ls, SNES_LINESEARCH_FAILED_REDUCT));
     return 0;
@@ -409,6 +462,8 @@ bool full_newton_step(SNES snes) {
 // stopped falling for two iterations: the damped updates then only move the state
 // at round-off level (seen on a stiff block on a slope: 1.8e-2 N -> 1.8e-10 N in
 // one step, then 50 iterations wandering at 1.8-2.0e-10 N).
+// With SolverOptions::newton_velocity_tol > 0, also converged when the last Newton
+// direction moves no node by more than tol * dt [m].
 PetscErrorCode QuasiStaticSolver::convergence(SNES snes, PetscInt it, PetscReal snorm, PetscReal fnorm,
                                               SNESConvergedReason* reason) {
   *reason = SNES_CONVERGED_ITERATING;
@@ -431,30 +486,31 @@ PetscErrorCode QuasiStaticSolver::convergence(SNES snes, PetscInt it, PetscReal 
     *reason = SNES_CONVERGED_SNORM_RELATIVE;
   } else if (stalled_its_ >= 2 && fnorm <= 1e-7 * fnorm0_) {
     *reason = SNES_CONVERGED_FNORM_RELATIVE;
+  } else if (it > 0 && opt_.newton_velocity_tol > 0 && direction_max_ <= opt_.newton_velocity_tol * dt_step_) {
+    *reason = SNES_CONVERGED_SNORM_RELATIVE;
   } else if (it >= opt_.max_newton_its) {
     *reason = SNES_DIVERGED_MAX_IT;
   }
   return 0;
 }
 
-bool QuasiStaticSolver::solve_step(double t_new, int& newton_its, int& linear_its, std::string& why) {
-  refresh_pieces();
-  // Predictor: linear extrapolation of the last increment, if it is admissible.
+// Newton's start in work_: u_n + dt (u_n - u_{n-1}) / dt_{n-1} (the last step's
+// velocity times dt; SolverOptions::extrapolate) or u_n, scaled back to stay
+// admissible, with the prescribed values at t_new. False (why, cause_) if even u_n
+// with the prescribed increment is outside the energy's domain.
+bool QuasiStaticSolver::predict(double t_new, std::string& why) {
+  static const PetscLogEvent event = log_event("Predictor");
+  LogEventScope scope(event);
   PETSC_CHECK(VecCopy(u_, work_));
   const double dt = t_new - t_;
-  if (dt_prev_ > 0) {  // work = u + (dt/dt_prev) (u - u_prev)
+  if (opt_.extrapolate && dt_prev_ > 0) {  // work = u + (dt/dt_prev) (u - u_prev)
     PETSC_CHECK(VecAXPY(work_, dt / dt_prev_, u_));
     PETSC_CHECK(VecAXPY(work_, -dt / dt_prev_, u_prev_));
-  }
-  for (const auto& term : assembler_.terms()) {
-    term->set_time(t_new);
-    term->begin_step(assembler_, u_, t_, t_new);
   }
   apply_dirichlet(work_, t_new);
   // Keep the predictor admissible (no jump through a contact surface).
   PETSC_CHECK(VecAXPY(work_, -1.0, u_));
-  double alpha = 1.0;
-  for (const auto& term : assembler_.terms()) alpha = std::min(alpha, term->max_step(assembler_, u_, work_));
+  const double alpha = admissible_step(u_, work_, nullptr);
   PETSC_CHECK(VecAYPX(work_, std::max(alpha, 0.0), u_));  // work = u + alpha (work - u)
   apply_dirichlet(work_, t_new);                          // prescribed values are never scaled
   if (!std::isfinite(assembler_.energy(work_))) {
@@ -466,6 +522,22 @@ bool QuasiStaticSolver::solve_step(double t_new, int& newton_its, int& linear_it
       return false;
     }
   }
+  return true;
+}
+
+bool QuasiStaticSolver::solve_step(double t_new, int& newton_its, int& linear_its, std::string& why) {
+  static const PetscLogEvent hooks_event = log_event("StepHooks");
+  refresh_pieces();
+  const double dt = t_new - t_;
+  dt_step_ = dt;
+  {
+    LogEventScope scope(hooks_event);
+    for (const auto& term : assembler_.terms()) {
+      term->set_time(t_new);
+      term->begin_step(assembler_, u_, t_, t_new);
+    }
+  }
+  if (!predict(t_new, why)) return false;
   Vec x;
   PETSC_CHECK(VecDuplicate(u_, &x));
   PETSC_CHECK(VecCopy(work_, x));
@@ -484,6 +556,7 @@ bool QuasiStaticSolver::solve_step(double t_new, int& newton_its, int& linear_it
     linear_its += static_cast<int>(lits);
     if (reason <= 0) break;
     bool again = false;
+    LogEventScope scope(hooks_event);
     for (const auto& term : assembler_.terms()) again = term->update_after_solve(assembler_, x) || again;
     if (!again) break;
     if (outer == opt_.max_outer_updates) reason = SNES_DIVERGED_MAX_IT;
@@ -491,6 +564,7 @@ bool QuasiStaticSolver::solve_step(double t_new, int& newton_its, int& linear_it
   bool ok = !ierr && reason > 0 && std::isfinite(assembler_.energy(x));
   advised_dt_ = 1e300;
   if (ok) {
+    LogEventScope scope(hooks_event);
     bool accept = true;
     for (const auto& term : assembler_.terms()) {
       const auto advice = term->advise_step(assembler_, x, t_, t_new);
@@ -506,6 +580,7 @@ bool QuasiStaticSolver::solve_step(double t_new, int& newton_its, int& linear_it
   if (ok) {
     PETSC_CHECK(VecCopy(u_, u_prev_));
     PETSC_CHECK(VecCopy(x, u_));
+    LogEventScope scope(hooks_event);
     for (const auto& term : assembler_.terms()) term->end_step(assembler_, u_, t_new);
     dt_prev_ = dt;
     t_ = t_new;
@@ -554,6 +629,9 @@ RunStats QuasiStaticSolver::run(const std::function<void(const StepReport&)>& on
       StepReport report{stats.steps, t_, dt_prev_, its, lits, cuts, assembler_.energy(u_)};
       if (its <= opt_.easy_newton_its && cuts == 0) dt = std::min(dt * opt_.grow, opt_.dt_max);
       dt = std::min(dt, advised_dt_);
+      if (step_monitor_)
+        PetscPrintf(assembler_.comm(), "  step %d: t = %.6g s, dt = %.4g s, %d Newton its, %d cuts, next dt %.4g s%s\n",
+                    stats.steps, t_, dt_prev_, its, cuts, dt, advised_dt_ <= dt ? " (a term's advice)" : "");
       dt_next_ = dt;  // before on_step, which may save a checkpoint
       counters_ = stats;
       cuts = 0;
@@ -569,6 +647,8 @@ RunStats QuasiStaticSolver::run(const std::function<void(const StepReport&)>& on
     } else {
       ++stats.step_cuts;
       ++stats.cuts_by_cause[cause_];
+      if (step_monitor_)
+        PetscPrintf(assembler_.comm(), "  cut: t = %.6g s, dt = %.4g s (%s)\n", t_, t_new - t_, cause_.c_str());
       ++cuts;
       dt = 0.5 * (t_new - t_);
       if (dt < opt_.dt_min) {

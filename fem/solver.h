@@ -9,6 +9,10 @@
 // indefinite); "mumps_lu" selects MUMPS LU, "gamg" CG + GAMG with the rigid-body
 // near-nullspace. Any PETSc option (-snes_*, -ksp_*, -pc_*) on the command line
 // overrides these defaults.
+//
+// Diagnostics: -morphfem_step_monitor prints a line per step (t, dt, Newton
+// iterations, the next dt) and per cut (its cause); -morphfem_linesearch_monitor
+// one per line search. Where the time goes: -log_view (events in fem/profile.h).
 #pragma once
 #include <petscsnes.h>
 
@@ -42,9 +46,18 @@ struct SolverOptions {
   double grow = 1.5;        // step growth after an easy solve
   int easy_newton_its = 6;  // "easy": converged in at most this many iterations
   int max_newton_its = 30;
-  int max_outer_updates = 20;           // re-solves a step while a term's update_after_solve asks
-  double rtol = 1e-9;                   // ||r|| <= rtol ||r_0|| ...
-  double atol_factor = 1e-11;           // ... or ||r|| <= atol_factor * (largest ||r_0|| seen)
+  int max_outer_updates = 20;  // re-solves a step while a term's update_after_solve asks
+  double rtol = 1e-9;          // ||r|| <= rtol ||r_0|| ...
+  double atol_factor = 1e-11;  // ... or ||r|| <= atol_factor * (largest ||r_0|| seen)
+  // ... or, if > 0, when the last Newton direction du (before the line search) moves
+  // no node by more than newton_velocity_tol * dt: max_a |du_a| / dt <= tol [m/s], a
+  // test in the units of the motion (IPC's). Off (0) by default; PETSc option
+  // -morphfem_newton_velocity_tol overrides it.
+  double newton_velocity_tol = 0.0;
+  // Newton's start: u_n + dt (u_n - u_{n-1}) / dt_{n-1} (the last step's velocity,
+  // which is implicit Euler's u_n + dt v_n) if true, else u_n. PETSc option
+  // -morphfem_extrapolate <bool> overrides it.
+  bool extrapolate = true;
   std::string linear_solver = "mumps";  // "mumps" (LDL^T) | "mumps_lu" | "gamg"
   // always: terms that project their Hessian to PSD (EnergyTerm::set_exact_hessian)
   // always do. adaptive: the first iteration of a solve and every one after a
@@ -122,7 +135,15 @@ class QuasiStaticSolver {
   void refresh_pieces();  // lets terms rebuild state-dependent pieces (then a new pattern)
   void rebuild_pattern();
   void attach_near_nullspace();
+  bool predict(double t_new, std::string& why);
   bool solve_step(double t_new, int& newton_its, int& linear_its, std::string& why);
+  // Largest alpha in [0, 1] with u + alpha du admissible for every term
+  // (EnergyTerm::max_step); `limiter` (optional) names the term that bounds it.
+  double admissible_step(Vec u, Vec du, std::string* limiter);
+  double largest_nodal_norm(Vec v) const;
+  PetscErrorCode print_line_search(Vec X, Vec Y, Vec W, double lambda_max, const std::string& limiter, double lambda,
+                                   bool accepted, double slope);
+  std::vector<PetscLogEvent> max_step_events_;  // "MaxStep:NAME" per term
 
   Assembler& assembler_;
   std::vector<DirichletCondition> bcs_;
@@ -141,8 +162,11 @@ class QuasiStaticSolver {
   int exact_hessian_its_ = 0, projection_fallbacks_ = 0;
   double fnorm0_ = 0.0, fnorm_scale_ = 0.0;
   double fnorm_prev_ = 0.0;                     // residual of the previous iteration [N]
+  double dt_step_ = 0.0;                        // the step being solved [s]
+  double direction_max_ = 0.0;                  // largest nodal |du| of the last Newton direction [m]
   int stalled_its_ = 0;                         // consecutive iterations without a 10 % residual decrease
   PetscBool linesearch_monitor_ = PETSC_FALSE;  // -morphfem_linesearch_monitor (read once)
+  PetscBool step_monitor_ = PETSC_FALSE;        // -morphfem_step_monitor: a line per step and per cut
   double length_scale_ = 1.0;                   // diagonal of the mesh's bounding box [m]
   std::string cause_;                           // short cause of the last failed attempt (RunStats::cuts_by_cause key)
   double advised_dt_ = 1e300;                   // smallest dt_next advised by the terms for the last attempt

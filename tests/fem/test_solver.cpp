@@ -102,3 +102,64 @@ TEST(QuasiStaticSolver, AdaptiveProjectionFallsBackWhereTheExactHessianFails) {
   EXPECT_LE(exact.stats.newton_its, always.stats.newton_its);
   EXPECT_LT(exact.error, 1e-8);
 }
+
+namespace {
+
+// Four steps of the quartic pull to t = 1 (the minimiser u_a = t d_a moves
+// linearly in time); `error` = max |u_a - d_a| at t = 1 [m].
+RunStats pull_in_steps(double newton_velocity_tol, bool extrapolate, double& error) {
+  const Mesh mesh = morphfem::testing::block_mesh({1, 1, 1}, 0.5, 1);
+  const Partition part = morphfem::testing::one_rank(mesh);
+  Assembler assembler(mesh, part, PETSC_COMM_SELF);
+  auto term = std::make_shared<QuarticPull>(mesh, 1.0);
+  assembler.add_term(term);
+  SolverOptions opt;
+  opt.t_end = 1.0;
+  opt.dt_initial = opt.dt_max = 0.25;
+  opt.max_newton_its = 50;
+  opt.newton_velocity_tol = newton_velocity_tol;
+  opt.extrapolate = extrapolate;
+  QuasiStaticSolver solver(assembler, {}, opt);
+  const RunStats stats = solver.run();
+  error = (assembler.gather_all(solver.solution()) - term->target()).cwiseAbs().maxCoeff();
+  return stats;
+}
+
+}  // namespace
+
+// SolverOptions::newton_velocity_tol: Newton stops once its last direction moves no
+// node faster than tol [m/s] over the step: a huge tolerance stops every solve after
+// one iteration, a tiny one changes nothing, a moderate one stops early with the
+// state within about tol * dt of the solution.
+TEST(QuasiStaticSolver, VelocityToleranceStopsNewtonOnTheDirection) {
+  double error_default = 0, error_huge = 0, error_tiny = 0, error_moderate = 0;
+  const RunStats base = pull_in_steps(0.0, false, error_default);
+  ASSERT_TRUE(base.completed) << base.failure;
+  ASSERT_EQ(base.steps, 4);
+  ASSERT_GT(base.newton_its, 2 * base.steps);
+  EXPECT_LT(error_default, 1e-10);
+  const RunStats huge = pull_in_steps(1e6, false, error_huge);
+  ASSERT_TRUE(huge.completed) << huge.failure;
+  EXPECT_EQ(huge.newton_its, huge.steps);
+  const RunStats tiny = pull_in_steps(1e-30, false, error_tiny);
+  EXPECT_EQ(tiny.newton_its, base.newton_its);
+  EXPECT_EQ(error_tiny, error_default);
+  const double tol = 1e-2;  // [m/s]; dt = 0.25 s
+  const RunStats moderate = pull_in_steps(tol, false, error_moderate);
+  ASSERT_TRUE(moderate.completed) << moderate.failure;
+  EXPECT_LT(moderate.newton_its, base.newton_its) << error_moderate;
+  EXPECT_LT(error_moderate, tol * 0.25);
+}
+
+// SolverOptions::extrapolate: the solution moves linearly in time, so from the second
+// step on the extrapolated start (u_n + dt (u_n - u_{n-1}) / dt_{n-1}) is the
+// solution and Newton has nothing left to do; starting from u_n it has.
+TEST(QuasiStaticSolver, ExtrapolatedStartSavesIterationsOnALinearMotion) {
+  double error_extrapolated = 0, error_from_last = 0;
+  const RunStats extrapolated = pull_in_steps(0.0, true, error_extrapolated);
+  const RunStats from_last = pull_in_steps(0.0, false, error_from_last);
+  ASSERT_TRUE(extrapolated.completed && from_last.completed);
+  EXPECT_LT(extrapolated.newton_its + 2 * (extrapolated.steps - 1), from_last.newton_its);
+  EXPECT_LT(error_extrapolated, 1e-10);
+  EXPECT_LT(error_from_last, 1e-10);
+}
