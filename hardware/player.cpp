@@ -289,6 +289,7 @@ class Run {
   void exchange_one(std::size_t i);
   bool reconnect(Line& l, const std::string& why);
   bool account_round();
+  void account_end();
   bool watch_pressures();
   bool tracking_fault(std::size_t i, double error);
   void step_modes();
@@ -317,7 +318,7 @@ class Run {
   double tau_ = 0, t_ = 0;
   bool finished_ = false, started_ = false, settled_ = false, round_interrupted_ = false;
   double last_wall_ = 0, last_display_ = 0;
-  std::vector<double> follow_, cmd_, meas_, read_t_, off_since_;
+  std::vector<double> follow_, cmd_, meas_, sent_t_, read_t_, off_since_;
   std::vector<int> off_samples_;
   std::vector<PressureWatch> watch_;
   // Columns entered since the last completed exchange: logged once it completes.
@@ -381,6 +382,7 @@ void Run::build_regulators() {
   follow_.assign(n, 0.0);
   cmd_.assign(n, 0.0);
   meas_.assign(n, kNaN);
+  sent_t_.assign(n, kNaN);
   read_t_.assign(n, kNaN);
   off_since_.assign(n, kNaN);
   off_samples_.assign(n, 0);
@@ -541,11 +543,13 @@ void Run::exchange_one(std::size_t i) {
   Regulator& r = regs_[i];
   for (int attempt = 0;; ++attempt) {
     try {
+      sent_t_[i] = t_ + (wall_s() - last_wall_) * opt_.time_scale;
       if (!(std::abs(cmd_[i] - r.sent) <= 0.5))
         meas_[i] = r.command(cmd_[i], opt_.reply_timeout_s);
       else
         meas_[i] = r.poll(opt_.reply_timeout_s);
-      // The reading's own schedule time: the host may have stalled since the tick began.
+      // The reading was taken within [sent_t_, read_t_] (schedule time): the host
+      // may have stalled since the tick began, or during the exchange.
       read_t_[i] = t_ + (wall_s() - last_wall_) * opt_.time_scale;
       return;
     } catch (const DisconnectedError& e) {
@@ -598,6 +602,18 @@ bool Run::account_round() {
   return true;
 }
 
+// The schedule ended inside a gap: the columns since the last completed exchange are lost.
+void Run::account_end() {
+  if (!std::isfinite(last_round_t_) || t_ - last_round_t_ <= opt_.max_gap_s) return;
+  lost_.push_back({last_round_k_, K_ - 1, last_round_t_, t_});
+  const std::string msg = "lost " + lost_.back().text() + " at the end of the schedule";
+  if (!opt_.continue_after_gap) {
+    fail(kExitLost, msg);
+    return;
+  }
+  log_->event(t_, k_, "fault", msg);
+}
+
 // The slow backstop: |measured - commanded| > tracking_fault_pa for tracking_fault_s
 // and tracking_fault_samples consecutive exchanges.
 bool Run::tracking_fault(std::size_t i, double error) {
@@ -616,7 +632,7 @@ bool Run::watch_pressures() {
   settled_ = true;
   for (std::size_t i = 0; i < regs_.size(); ++i) {
     const double e = std::abs(meas_[i] - cmd_[i]);
-    std::string why = watch_[i].add(read_t_[i], cmd_[i], meas_[i]);
+    std::string why = watch_[i].add(sent_t_[i], read_t_[i], cmd_[i], meas_[i]);
     if (why.empty() && tracking_fault(i, e))
       why = "measured " + kpa(meas_[i]) + " kPa, commanded " + kpa(cmd_[i]) + " kPa for " +
             seconds_text(t_ - off_since_[i]) + " s";
@@ -777,6 +793,7 @@ int Run::execute() {
     show();
   }
   if (opt_.display) err_ << "\n";
+  if (finished_ && code_ == kExitOk && !opt_.dry_run) account_end();
   if (code_ != kExitOk)
     log_->event(t_, k_, "fault", fault_);
   else

@@ -16,11 +16,11 @@ std::string fixed(double v, int decimals) {
 
 }  // namespace
 
-std::string PressureWatch::add(double t, double commanded_pa, double measured_pa) {
+std::string PressureWatch::add(double sent_t, double read_t, double commanded_pa, double measured_pa) {
   if (!std::isfinite(commanded_pa) || !std::isfinite(measured_pa)) return "";
-  hist_.push_back({t, commanded_pa, measured_pa});
-  // Keep the newest sample at or before t - window_s as the stall check's anchor.
-  while (hist_.size() > 2 && hist_[1].t <= t - s_.window_s) hist_.pop_front();
+  hist_.push_back({std::min(sent_t, read_t), read_t, commanded_pa, measured_pa});
+  // Keep the newest sample surely window_s before this one as the stall check's anchor.
+  while (hist_.size() > 2 && hist_[1].t <= hist_.back().t0 - s_.window_s) hist_.pop_front();
   const double e = commanded_pa - measured_pa;
   if (std::abs(e) <= s_.off_pa) return "";
   const int side = e > 0 ? 1 : -1;  // +1: measured below the setpoint
@@ -53,13 +53,14 @@ std::string PressureWatch::falling(int side) const {
 std::string PressureWatch::stalled(int side) const {
   const Sample& now = hist_.back();
   const Sample& anchor = hist_.front();
-  if (now.t - anchor.t < s_.window_s) return "";
+  const double span = now.t0 - anchor.t;  // the shortest time the two readings can be apart
+  if (span < s_.window_s) return "";
   for (const Sample& s : hist_)
     if (side * (s.cmd - s.meas) <= s_.off_pa) return "";
-  const double rate = side * (now.meas - anchor.meas) / (now.t - anchor.t);
+  const double rate = side * (now.meas - anchor.meas) / span;
   if (rate >= s_.min_rate_pa_per_s) return "";
   return "measured " + fixed(now.meas / 1000, 1) + " kPa, setpoint " + fixed(now.cmd / 1000, 1) +
-         " kPa: approaching it at " + fixed(rate / 1000, 1) + " kPa/s over " + fixed(now.t - anchor.t, 3) +
+         " kPa: approaching it at " + fixed(rate / 1000, 1) + " kPa/s over " + fixed(span, 3) +
          " s, expected at least " + fixed(s_.min_rate_pa_per_s / 1000, 1) + " kPa/s";
 }
 

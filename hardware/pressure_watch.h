@@ -10,9 +10,10 @@
 //    approached the setpoint at less than min_rate_pa_per_s over that time (a
 //    ruptured bladder that cannot fill, a leak, a valve stuck closed).
 // Detection bound: a trip comes at the first sample after the pressure fell
-// (falling), or at the first sample at least window_s after the channel went
-// off (stalled); with samples every h seconds both are within window_s + h of
-// the first off sample, i.e. within window_s + 2h of the fault itself.
+// (falling), or at the first sample at least window_s (plus the duration of one
+// exchange) after the channel went off (stalled); with samples every h seconds
+// both are within window_s + h of the first off sample, i.e. within window_s + 2h
+// of the fault itself.
 #pragma once
 #include <deque>
 #include <string>
@@ -30,15 +31,19 @@ struct WatchSettings {
 class PressureWatch {
  public:
   explicit PressureWatch(WatchSettings s = {}) : s_(s) {}
-  // Adds one exchange (device time t, commanded and measured pressure). Returns
-  // "" or, when the channel trips, what was seen ("pressure fell 15.2 kPa ...").
-  std::string add(double t, double commanded_pa, double measured_pa);
+  // Adds one exchange: the reading was taken between device times sent_t (request
+  // about to be written) and read_t (reply received), with the setpoint commanded
+  // then. Returns "" or, when the channel trips, what was seen ("pressure fell
+  // 15.2 kPa ..."). Rates use the shortest interval the two readings can be apart,
+  // so a stall of the host between a reading and its time stamp cannot fake a stall.
+  std::string add(double sent_t, double read_t, double commanded_pa, double measured_pa);
+  std::string add(double t, double commanded_pa, double measured_pa) { return add(t, t, commanded_pa, measured_pa); }
   // Forgets the history (after a reconnection: old samples are no evidence).
   void reset() { hist_.clear(); }
 
  private:
   struct Sample {
-    double t, cmd, meas;
+    double t0, t, cmd, meas;  // the reading was taken within [t0, t]
   };
   std::string falling(int side) const;
   std::string stalled(int side) const;

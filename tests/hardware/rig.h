@@ -83,10 +83,10 @@ struct Rig {
     emu->start();
     opt.time_scale = setup.time_scale;
     opt.reply_timeout_s = 1.0;
-    // Columns are lost after 0.5 s of wall time without an exchange (0.5 s of
-    // schedule time at 1x, 5 s at 10x): a loaded test host stalls the player for
-    // 100+ ms now and then, which these tests are not about. The gap tests set
-    // the player's default (0.5 s of schedule time).
+    // Columns are lost after 0.5 s of wall time without an exchange: the player's
+    // default, 0.5 s of schedule time, at 1x; 5 s at 10x, where a loaded test host
+    // (load average 16 on 2 cores seen) stalls the player for 50-500 ms now and
+    // then. The gap tests disconnect for 0.8-1 s of wall time.
     opt.max_gap_s = 0.5 * setup.time_scale;
     opt.allow_map_override = setup.core_override;
     opt.log_path = dir + "/log.csv";
