@@ -91,7 +91,21 @@ std::string kpa_text(double pa) {
   return b;
 }
 
-std::string column_name(int column) { return column < 0 ? "rest" : "column " + std::to_string(column + 1); }
+// "rest", "column 3", "columns 3-5", "rest and columns 1-8" for columns first..last (-1 = rest).
+std::string columns_name(int first, int last) {
+  std::string rest = first < 0 ? "rest" : "";
+  if (first < 0) first = 0;
+  if (last < first) return rest;
+  std::string cols = first == last ? "column " + std::to_string(first + 1)
+                                   : "columns " + std::to_string(first + 1) + "-" + std::to_string(last + 1);
+  return rest.empty() ? cols : rest + " and " + cols;
+}
+
+bool same_change(const PressureChange& a, const PressureChange& b) {
+  auto same = [](double x, double y) { return x == y || (std::isnan(x) && std::isnan(y)); };
+  return a.channel == b.channel && b.column == a.column + 1 && same(a.schedule_pa, b.schedule_pa) &&
+         same(a.commanded_pa, b.commanded_pa) && a.reason == b.reason;
+}
 
 // Why the map commands `commanded` where the schedule asks for `wanted`.
 std::string change_reason(const ChannelSpec* c, bool inflated, double wanted, double effective, double commanded) {
@@ -132,9 +146,14 @@ PressurePlan ChannelMap::plan(const Schedule& s) const {
 
 std::string PressurePlan::describe_changes() const {
   std::ostringstream o;
-  for (const auto& c : changes)
-    o << "  " << channel_name(c.channel) << " " << column_name(c.column) << ": schedule " << kpa_text(c.schedule_pa)
-      << ", commanded " << kpa_text(c.commanded_pa) << " (" << c.reason << ")\n";
+  for (std::size_t i = 0; i < changes.size();) {
+    std::size_t j = i;  // consecutive columns with the same change are one line
+    while (j + 1 < changes.size() && same_change(changes[j], changes[j + 1])) ++j;
+    const PressureChange& c = changes[i];
+    o << "  " << channel_name(c.channel) << " " << columns_name(c.column, changes[j].column) << ": schedule "
+      << kpa_text(c.schedule_pa) << ", commanded " << kpa_text(c.commanded_pa) << " (" << c.reason << ")\n";
+    i = j + 1;
+  }
   return o.str();
 }
 

@@ -195,7 +195,8 @@ int run_check(const std::vector<std::string>& args) {
     std::cout << "the map plays the schedule's pressures unchanged\n";
     return kExitOk;
   }
-  const std::string what = "the map changes " + std::to_string(plan.changes.size()) + " pressure(s) of the schedule";
+  const std::string what =
+      "the map changes " + std::to_string(plan.changes.size()) + " pressure(s) (channel and column) of the schedule";
   if (!allow_override)
     throw InputError(map_path, "hw play would refuse this schedule: " + what + ":\n" + plan.describe_changes() +
                                    "give --allow-map-override to play them as listed");

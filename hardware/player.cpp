@@ -340,12 +340,12 @@ void Run::check_input() {
   levels_ = map_.effective_levels(s_);
   const PressurePlan plan = map_.plan(s_);
   if (plan.changes.empty()) return;
-  const std::string what = "the map " + map_.source + " changes " + std::to_string(plan.changes.size()) +
-                           " pressure(s) of schedule " + (s_.source.empty() ? s_.name : s_.source);
+  const std::string what = "the map changes " + std::to_string(plan.changes.size()) +
+                           " pressure(s) (channel and column) of schedule " + (s_.source.empty() ? s_.name : s_.source);
   if (!opt_.allow_map_override)
     throw InputError(map_.source, "refused before sending anything: " + what + ":\n" + plan.describe_changes() +
                                       "give --allow-map-override to play them as listed");
-  say(what + " (--allow-map-override):\n" + plan.describe_changes());
+  say(map_.source + ": " + what + " (--allow-map-override):\n" + plan.describe_changes());
 }
 
 void Run::build_regulators() {

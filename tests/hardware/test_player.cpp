@@ -184,7 +184,8 @@ TEST(Player, DryRunPrintsTheCommandStream) {
   EXPECT_NE(s.find("core alicat tx AS 50.000\\r"), std::string::npos);
   EXPECT_NE(s.find("vent foot_b alicat tx CS 0.000\\r"), std::string::npos);
   // The map's change is printed: the schedule's 12 kPa core is held at 50 kPa.
-  EXPECT_NE(err.str().find("core rest: schedule 12.0 kPa, commanded 50.0 kPa"), std::string::npos) << err.str();
+  EXPECT_NE(err.str().find("core rest and columns 1-8: schedule 12.0 kPa, commanded 50.0 kPa"), std::string::npos)
+      << err.str();
 }
 
 class GaitTest : public ::testing::TestWithParam<std::tuple<std::string, bool>> {};

@@ -89,9 +89,9 @@ TEST(MapPlan, ListsTheCoreHeldByTheExampleMap) {
   ASSERT_EQ(p.changes.size(), 9u);  // rest + 8 columns, the core only
   for (auto& c : p.changes) EXPECT_EQ(c.channel, kChannelCore);
   std::string d = p.describe_changes();
-  EXPECT_NE(
-      d.find("core column 3: schedule 0.0 kPa, commanded 50.0 kPa (inflated_pa of " + kExamples + "channel_map.yaml:"),
-      std::string::npos)
+  EXPECT_NE(d.find("core rest and columns 1-8: schedule 0.0 kPa, commanded 50.0 kPa (inflated_pa of " + kExamples +
+                   "channel_map.yaml:"),
+            std::string::npos)
       << d;
   EXPECT_NE(d.find("channels.core (the core's held pressure)"), std::string::npos) << d;
   EXPECT_NE(p.table().find("core              50.0   50.0"), std::string::npos) << p.table();
@@ -146,7 +146,7 @@ TEST(MapOverride, PlayRefusesAnOverridingMapBeforeAnythingIsSent) {
   } catch (const InputError& e) {
     std::string w = e.what();
     EXPECT_NE(w.find("refused before sending anything"), std::string::npos) << w;
-    EXPECT_NE(w.find("core column 1: schedule 12.0 kPa, commanded 30.0 kPa"), std::string::npos) << w;
+    EXPECT_NE(w.find("core rest and columns 1-8: schedule 12.0 kPa, commanded 30.0 kPa"), std::string::npos) << w;
     EXPECT_NE(w.find("--allow-map-override"), std::string::npos) << w;
   }
   EXPECT_EQ(rig.emu->requests(), 0);
@@ -158,8 +158,9 @@ TEST(MapOverride, AllowedOverridesArePrintedAndPlayed) {
   Schedule s = read_schedule(kExamples + "inching.yaml");
   s.repeats = 1;
   ASSERT_EQ(rig.play(s), kExitOk) << rig.err.str();
-  EXPECT_NE(rig.err.str().find("changes 9 pressure(s) of schedule"), std::string::npos) << rig.err.str();
-  EXPECT_NE(rig.err.str().find("core column 8: schedule 0.0 kPa, commanded 30.0 kPa"), std::string::npos)
+  EXPECT_NE(rig.err.str().find("changes 9 pressure(s) (channel and column) of schedule"), std::string::npos)
+      << rig.err.str();
+  EXPECT_NE(rig.err.str().find("core rest and columns 1-8: schedule 0.0 kPa, commanded 30.0 kPa"), std::string::npos)
       << rig.err.str();
   EXPECT_GT(rig.emu->channel(kChannelCore).max_pressure_pa, 25000);
 }
