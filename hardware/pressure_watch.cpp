@@ -55,8 +55,12 @@ std::string PressureWatch::stalled(int side) const {
   const Sample& anchor = hist_.front();
   const double span = now.t0 - anchor.t;  // the shortest time the two readings can be apart
   if (span < s_.window_s) return "";
-  for (const Sample& s : hist_)
-    if (side * (s.cmd - s.meas) <= s_.off_pa) return "";
+  // Off all along: each reading from its own setpoint, and from the setpoint that
+  // acted until the next reading (a reading shows the pressure before its command acts).
+  for (std::size_t k = 0; k < hist_.size(); ++k) {
+    if (side * (hist_[k].cmd - hist_[k].meas) <= s_.off_pa) return "";
+    if (k + 1 < hist_.size() && side * (hist_[k].cmd - hist_[k + 1].meas) <= s_.off_pa) return "";
+  }
   const double rate = side * (now.meas - anchor.meas) / span;
   if (rate >= s_.min_rate_pa_per_s) return "";
   return "measured " + fixed(now.meas / 1000, 1) + " kPa, setpoint " + fixed(now.cmd / 1000, 1) +

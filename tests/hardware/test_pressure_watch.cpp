@@ -127,3 +127,15 @@ TEST(PressureWatch, ResetForgetsTheHistory) {
   // Without the 25 kPa sample there is no fall to see; one off sample is no stall.
   EXPECT_EQ(w.add(0.05, 25000, 4800), "");
 }
+
+TEST(PressureWatch, AReadingBehindARampingSetpointIsNoStall) {
+  // A setpoint ramps down 25 -> 0 kPa; the regulator holds each command until the
+  // next, and a reading shows the pressure before the command sent with it acts.
+  // With readings 0.35 s apart (a stalled host at 10x) the pressure followed the
+  // previous command, not the current one: no trip.
+  PressureWatch w;
+  EXPECT_EQ(w.add(0.0, 0.0, 14900, 25000), "");   // command 14.9 kPa, reading still 25 kPa
+  EXPECT_EQ(w.add(0.01, 0.01, 9900, 15000), "");  // the regulator reached 14.9 kPa; now 9.9 kPa
+  EXPECT_EQ(w.add(0.36, 0.36, 0, 9900), "");      // held 9.9 kPa for 0.35 s; now 0 kPa
+  EXPECT_EQ(w.add(0.40, 0.40, 0, 0), "");
+}
