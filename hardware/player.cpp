@@ -310,6 +310,7 @@ class Run {
   std::ostream& err_;
   double tick_s_ = 0.02;
   std::array<ChannelLevels, kNumChannels> levels_{};
+  PressurePlan plan_;
   std::vector<Regulator> regs_;
   std::vector<std::unique_ptr<Line>> lines_;
   std::unique_ptr<CsvLog> log_;
@@ -338,7 +339,8 @@ void Run::check_input() {
   tick_s_ = opt_.tick_s > 0 ? opt_.tick_s : std::max(0.005, 0.02 / opt_.time_scale);
   if (!(opt_.max_gap_s > 0)) throw InputError("--max-gap-s", "must be positive");
   levels_ = map_.effective_levels(s_);
-  const PressurePlan plan = map_.plan(s_);
+  plan_ = map_.plan(s_);
+  const PressurePlan& plan = plan_;
   if (plan.changes.empty()) return;
   const std::string what = "the map changes " + std::to_string(plan.changes.size()) +
                            " pressure(s) (channel and column) of schedule " + (s_.source.empty() ? s_.name : s_.source);
@@ -409,6 +411,8 @@ void Run::open_log() {
   log.meta("mode", opt_.mode == Mode::fixed ? "fixed" : opt_.mode == Mode::settle ? "settle" : "step");
   log.meta("time_scale", std::to_string(opt_.time_scale));
   log.meta("dry_run", opt_.dry_run ? "yes" : "no");
+  std::istringstream changes(plan_.describe_changes());  // played with --allow-map-override
+  for (std::string line; std::getline(changes, line);) log.meta("map_change", line.substr(line.find_first_not_of(' ')));
   log.header();
 }
 

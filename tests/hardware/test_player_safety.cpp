@@ -183,6 +183,13 @@ TEST(MapOverride, AllowedOverridesArePrintedAndPlayed) {
   EXPECT_NE(rig.err.str().find("core rest and columns 1-8: schedule 0.0 kPa, commanded 30.0 kPa"), std::string::npos)
       << rig.err.str();
   EXPECT_GT(rig.emu->channel(kChannelCore).max_pressure_pa, 25000);
+  // The log records what was changed.
+  PressureTrace tr = read_pressure_log(rig.opt.log_path);
+  auto change = std::find_if(tr.metadata.begin(), tr.metadata.end(), [](auto& kv) { return kv.first == "map_change"; });
+  ASSERT_NE(change, tr.metadata.end());
+  EXPECT_EQ(change->second.rfind("core rest and columns 1-8: schedule 0.0 kPa, commanded 30.0 kPa (inflated_pa of", 0),
+            0u)
+      << change->second;
 }
 
 TEST(MapOverride, CheckPrintsWhatIsCommandedAndRefusesLikePlay) {
