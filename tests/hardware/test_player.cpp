@@ -32,7 +32,7 @@ namespace {
 // Measured pressures at the last sample of every column match the commands within
 // tol. A column is evidence only if its last sample came at least 0.5 column_s
 // = 0.62 s after its first (when its commands went out; the valves settle in
-// about 5 tau = 0.6 s; a tick is 0.2 s of schedule time at 10x): after a
+// about 5 tau = 0.6 s; a tick is 0.05 s of schedule time at 10x): after a
 // stall of the host longer than a column (124 ms wall at 10x) its only sample
 // is the one that sent the commands. Nine in ten columns must be evidence.
 void expect_tracking(const PressureTrace& tr, const Schedule& s, double tol) {
@@ -289,8 +289,9 @@ TEST(Player, ReconnectsWhenThePortComesBack) {
 // reported as themselves. On a loaded machine the emulator's valve model can lag the
 // commands by more than the default 1 s of schedule time, and the tracking fault then
 // fires first (seen once in CI: "tracking fault on b1 ... for 1.19 s" before "reply
-// timeout"). These tests therefore give tracking 10 s. Tracking itself is tested by
-// Rupture and StuckValve, with the default.
+// timeout"). These tests therefore give that backstop 10 s. Rupture and leak
+// detection (pressure_watch.h) keeps its defaults here; it and the backstop are
+// tested by Rupture, StuckValve and test_player_safety.cpp.
 constexpr double kCommsTrackingS = 10.0;
 
 void expect_fault_handled(Rig& rig, int code, int expect_code, const std::string& text) {
