@@ -347,7 +347,9 @@ void Run::check_input() {
   if (!opt_.allow_map_override)
     throw InputError(map_.source, "refused before sending anything: " + what + ":\n" + plan.describe_changes() +
                                       "give --allow-map-override to play them as listed");
-  say(map_.source + ": " + what + " (--allow-map-override):\n" + plan.describe_changes());
+  std::string list = plan.describe_changes();
+  list.pop_back();  // say() ends the line
+  say(map_.source + ": " + what + " (--allow-map-override):\n" + list);
 }
 
 void Run::build_regulators() {
