@@ -91,6 +91,7 @@ class AtTimeScale : public ::testing::TestWithParam<double> {
     RigSetup s;
     s.time_scale = GetParam();
     s.core_override = core_override;
+    s.tick_s = 0;  // the player's default: a reading every 0.02 s (1x) or 0.05 s (10x) of device time
     return s;
   }
   std::string tag(const std::string& name) const { return name + "_x" + std::to_string(int(GetParam())); }
@@ -380,7 +381,7 @@ TEST(PlayerRupture, EmulatorRuptureFaultOnB5IsCaughtUnderTheRollingGait) {
   for (const std::string spec : {"rupture@5:b5", "rupture@7:b5"}) {
     EmulatorConfig cfg;
     cfg.faults.push_back(parse_fault(spec));
-    Rig rig("rupture_b5", false, cfg, RigSetup{false, false, 10});
+    Rig rig("rupture_b5", false, cfg, RigSetup{false, false, 10, 0});
     Schedule s = read_schedule(kExamples + "rolling.yaml");
     EXPECT_EQ(rig.play(s), kExitFault) << spec << ": " << rig.err.str();
     EXPECT_NE(rig.err.str().find("tracking fault on b5 "), std::string::npos) << spec << ": " << rig.err.str();
