@@ -24,7 +24,13 @@
 // hard limits (required): a schedule that needs a pressure outside them is
 // refused before anything is sent, and every command is clamped to them.
 // ramp_limit_pa_per_s (default: none) limits how fast a setpoint may change;
-// tolerance_pa (default 2000) is the settle tolerance of `--mode settle`.
+// tolerance_pa (default 2000) is the settle tolerance of `--mode settle`;
+// min_fill_rate_pa_per_s (default: the player's --min-fill-rate-pa-per-s) is the
+// slowest rate at which the measured pressure may approach a setpoint it is
+// more than 5 kPa away from before the player calls it a leak or rupture.
+// The limits must lie inside the device's sensor range [sensor_min_pa,
+// sensor_max_pa] (default -100..100 kPa, both protocols): beyond it the
+// reading saturates and a Booth setpoint is clipped at 1023 counts.
 #pragma once
 #include <optional>
 #include <string>
@@ -55,7 +61,30 @@ struct ChannelSpec {
   double min_pa = 0, max_pa = 0;
   double ramp_limit_pa_per_s = 0;  // 0 = no limit
   double tolerance_pa = 2000;
+  std::optional<double> min_fill_rate_pa_per_s;
   std::string where;  // "file:line:col: channels.b1" for messages
+};
+
+// A pressure of the schedule that the map changes before it is commanded.
+struct PressureChange {
+  int channel = -1;
+  int column = -1;          // matrix column 0..T-1; -1 = rest (settle phase and the end)
+  double schedule_pa = 0;   // what the schedule asks for
+  double commanded_pa = 0;  // what the player commands (NaN: the channel is not driven)
+  std::string reason;       // "inflated_pa of channels.b1 (map.yaml:17:7)", ...
+};
+
+// The pressures commanded per channel and matrix column after the map.
+struct PressurePlan {
+  int columns = 0;  // T
+  // [channel][0] = rest, [channel][1 + k] = matrix column k; commanded NaN = not driven.
+  std::array<std::vector<double>, kNumChannels> schedule_pa, commanded_pa;
+  std::vector<PressureChange> changes;  // every entry where the two differ
+
+  // "b1 column 3: schedule 90.0 kPa, commanded 25.0 kPa (inflated_pa of ...)", one per line.
+  std::string describe_changes() const;
+  // Table: a row per channel, a column per matrix column (kPa), rest first.
+  std::string table() const;
 };
 
 struct ChannelMap {
@@ -70,6 +99,9 @@ struct ChannelMap {
   // Throws InputError if the schedule asks for a pressure beyond a limit, or
   // inflates a channel the map does not drive. Nothing has been sent yet.
   void check_schedule(const Schedule& s) const;
+  // What is commanded per channel and column, and every change the map makes
+  // (level overrides, the core's held pressure, clamps, channels not driven).
+  PressurePlan plan(const Schedule& s) const;
 };
 
 ChannelMap read_channel_map(const std::string& path);

@@ -34,6 +34,7 @@ struct Emulator::Chan {
   double half_band_pa = 0;
   long commands = 0;
   double max_p = 0;
+  double ruptured_at = -1, vented_at = -1;
   std::uint8_t regs[booth::kRegisters] = {};
 };
 
@@ -198,7 +199,8 @@ std::vector<EmulatedChannelState> Emulator::snapshot() const {
   std::lock_guard<std::mutex> lock(mu_);
   std::vector<EmulatedChannelState> out;
   for (auto& c : chans_)
-    out.push_back({c->channel, c->p, c->sp, c->mode, c->ruptured, c->stuck, c->commands, c->max_p});
+    out.push_back(
+        {c->channel, c->p, c->sp, c->mode, c->ruptured, c->stuck, c->commands, c->max_p, c->ruptured_at, c->vented_at});
   return out;
 }
 
@@ -241,7 +243,10 @@ void Emulator::step_physics(double dt) {
       // Exact-enough explicit step; the limits keep it inside the physical range.
       c.p = std::clamp(c.p + h * dp, cfg_.vacuum_pa, cfg_.supply_pa);
       c.max_p = std::max(c.max_p, c.p);
-      if (!c.ruptured && c.p > (bladder ? cfg_.rupture_pa : cfg_.rupture_core_pa)) c.ruptured = true;
+      if (!c.ruptured && c.p > (bladder ? cfg_.rupture_pa : cfg_.rupture_core_pa)) {
+        c.ruptured = true;
+        c.ruptured_at = fault_clock() + (i + 1) * h;  // t_emu_ advances after the loop
+      }
     }
   }
   t_emu_ += dt;
@@ -342,9 +347,10 @@ void Emulator::handle_booth(Device& d, const booth::Frame& f) {
       c->sp = sensor.pressure(booth::get_counts(c->regs[booth::kRegSetpointHi], c->regs[booth::kRegSetpointLo]));
       c->half_band_pa = c->regs[booth::kRegHalfBand] * sensor.resolution_pa();
       std::uint8_t st = c->regs[booth::kRegDesiredState];
-      if (st == booth::kStateVent)
+      if (st == booth::kStateVent) {
         c->mode = 0;
-      else if (c->regs[booth::kRegMode] == 0 || st == booth::kStateHold)
+        if (c->vented_at < 0) c->vented_at = fault_clock();
+      } else if (c->regs[booth::kRegMode] == 0 || st == booth::kStateHold)
         c->mode = 2;
       else
         c->mode = 1;
@@ -375,8 +381,8 @@ void Emulator::handle_booth(Device& d, const booth::Frame& f) {
   }
 }
 
-void Emulator::serve(Device& d, double now_wall) {
-  // Flush due replies.
+// Writes the replies that are due (all of them unless a `delay` fault holds them).
+void Emulator::flush_replies(Device& d, double now_wall) {
   while (!d.out.empty() && d.out.front().due <= now_wall) {
     auto& b = d.out.front().bytes;
     if (!b.empty()) {
@@ -385,6 +391,10 @@ void Emulator::serve(Device& d, double now_wall) {
     }
     d.out.pop_front();
   }
+}
+
+void Emulator::serve(Device& d, double now_wall) {
+  flush_replies(d, now_wall);
   std::uint8_t buf[512];
   for (;;) {
     ssize_t r = ::read(d.master, buf, sizeof buf);
@@ -419,6 +429,7 @@ void Emulator::serve(Device& d, double now_wall) {
       handle_alicat(d, line);
     }
   }
+  flush_replies(d, wall_s());  // answer within this loop turn (replies are due from when they were made)
 }
 
 void Emulator::fire_faults(double now_wall) {
@@ -455,7 +466,10 @@ void Emulator::fire_faults(double now_wall) {
         break;
       case EmulatorFault::rupture:
         for (auto& c : chans_)
-          if (c->channel == f.channel) c->ruptured = true;
+          if (c->channel == f.channel && !c->ruptured) {
+            c->ruptured = true;
+            c->ruptured_at = rel;
+          }
         break;
     }
   }

@@ -79,6 +79,9 @@ struct EmulatedChannelState {
   bool stuck = false;
   long commands = 0;
   double max_pressure_pa = 0;
+  // Emulated seconds since the first request (the clock of --fault times); -1: never.
+  double ruptured_at_s = -1;  // the bladder ruptured (pressure limit or fault)
+  double vented_at_s = -1;    // first write of the Booth "vent" state (the player's vent)
 };
 
 class Emulator {
@@ -112,6 +115,8 @@ class Emulator {
   void send(Device& d, std::vector<std::uint8_t> bytes);
   double measure(const Chan& c, Protocol p);
   void fire_faults(double now_wall);
+  void flush_replies(Device& d, double now_wall);
+  double fault_clock() const { return t_first_request_ < 0 ? 0 : t_emu_ - t_first_request_; }
 
   ChannelMap map_;
   EmulatorConfig cfg_;

@@ -51,7 +51,8 @@ struct Regulator {
   ChannelSpec spec;
   DeviceSpec dev;
   Line* line = nullptr;
-  double sent = kNaN;  // last setpoint acknowledged by the device
+  double sent = kNaN;        // last setpoint acknowledged by the device
+  bool pressurised = false;  // a setpoint other than 0 Pa was sent (perhaps unacknowledged)
 
   std::string label() const {
     std::string a =
@@ -136,6 +137,7 @@ struct Regulator {
 
   // Sends a setpoint; returns the measured pressure.
   double command(double pa, double timeout) {
+    if (std::abs(pa) > 0.5) pressurised = true;
     if (dev.protocol == Protocol::alicat) {
       AlicatFrame f = alicat_exchange(alicat_setpoint(char(spec.address), pa), timeout);
       sent = pa;
@@ -238,361 +240,582 @@ struct SignalGuard {
   }
 };
 
-}  // namespace
+// "column 5" or "columns 5-13" (1-based).
+std::string columns_text(int first, int last) {
+  if (first == last) return "column " + std::to_string(first + 1);
+  return "columns " + std::to_string(first + 1) + "-" + std::to_string(last + 1);
+}
 
-void request_stop(int signal_number) { g_stop_signal.store(signal_number); }
+std::string seconds_text(double s) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.2f", s);
+  return b;
+}
 
-int play(const Schedule& schedule, const ChannelMap& map, const PlayerOptions& opt) {
-  std::ostream& out = opt.out ? *opt.out : std::cout;
-  std::ostream& err = opt.err ? *opt.err : std::cerr;
+// Columns that had no completed exchange for longer than max_gap_s.
+struct LostSpan {
+  int first_column, last_column;  // -1 = the rest phase
+  double from_t, to_t;            // schedule time of the exchanges around the gap (s)
+  std::string text() const {
+    std::string what = last_column < 0    ? std::string("the rest phase")
+                       : first_column < 0 ? "the rest phase and " + columns_text(0, last_column)
+                                          : columns_text(first_column, last_column);
+    return what + " (" + seconds_text(to_t - from_t) + " s of schedule time without a completed exchange, t " +
+           seconds_text(from_t) + "-" + seconds_text(to_t) + " s)";
+  }
+};
+
+// One run of the player: set-up, the control loop, venting and the report.
+class Run {
+ public:
+  Run(const Schedule& s, const ChannelMap& m, const PlayerOptions& o)
+      : s_(s), map_(m), opt_(o), out_(o.out ? *o.out : std::cout), err_(o.err ? *o.err : std::cerr) {}
+  int execute();
+
+ private:
   using Mode = PlayerOptions::Mode;
+  void check_input();
+  void build_regulators();
+  void open_log();
+  bool start_devices();
+  void print_dry_run_init();
+  bool stop_requested();
+  double next_dt();
+  void advance(double dt);
+  void enter_column(int k);
+  void update_commands(double dt);
+  void exchange_dry_run();
+  bool exchange();
+  void exchange_one(std::size_t i);
+  bool reconnect(Line& l, const std::string& why);
+  bool account_round();
+  void account_end();
+  bool watch_pressures();
+  bool tracking_fault(std::size_t i, double error);
+  void step_modes();
+  void show();
+  void vent_all();
+  bool vent_one(Regulator& r, double deadline);
+  int report();
+  void fail(int code, const std::string& why) {
+    code_ = code;
+    fault_ = why;
+  }
+  void say(const std::string& m) { err_ << "morphfem hw: " << m << "\n" << std::flush; }
 
-  // ---- 1. Refuse anything beyond a limit before a port is opened. --------------
-  schedule.validate();
-  map.check_schedule(schedule);
-  const auto levels = map.effective_levels(schedule);
-  if (!(opt.time_scale > 0) || !(opt.tick_s > 0)) throw InputError("options", "time scale and tick must be positive");
+  const Schedule& s_;
+  const ChannelMap& map_;
+  const PlayerOptions& opt_;
+  std::ostream& out_;
+  std::ostream& err_;
+  double tick_s_ = 0.02;
+  std::array<ChannelLevels, kNumChannels> levels_{};
+  PressurePlan plan_;
+  std::vector<Regulator> regs_;
+  std::vector<std::unique_ptr<Line>> lines_;
+  std::unique_ptr<CsvLog> log_;
+  // Clock: column k_ (-1 = settling before column 0), tau_ s into it, schedule time t_.
+  int K_ = 0, k_ = -1;
+  double tau_ = 0, t_ = 0;
+  bool finished_ = false, started_ = false, settled_ = false, round_interrupted_ = false;
+  double last_wall_ = 0, last_display_ = 0;
+  std::vector<double> follow_, cmd_, meas_, sent_t_, read_t_, off_since_;
+  std::vector<int> off_samples_;
+  std::vector<PressureWatch> watch_;
+  // Columns entered since the last completed exchange: logged once it completes.
+  std::vector<std::pair<int, double>> pending_columns_;
+  double last_round_t_ = kNaN;
+  int last_round_k_ = -1;
+  std::vector<LostSpan> lost_;
+  int code_ = kExitOk;
+  std::string fault_, stop_reason_, vent_msg_;
+  std::vector<std::string> not_vented_;
+};
 
-  std::vector<Regulator> regs;
-  std::vector<std::unique_ptr<Line>> lines;
+void Run::check_input() {
+  s_.validate();
+  map_.check_schedule(s_);
+  if (!(opt_.time_scale > 0)) throw InputError("--time-scale", "must be positive");
+  tick_s_ = opt_.tick_s > 0 ? opt_.tick_s : std::max(0.005, 0.02 / opt_.time_scale);
+  if (!(opt_.max_gap_s > 0)) throw InputError("--max-gap-s", "must be positive");
+  levels_ = map_.effective_levels(s_);
+  plan_ = map_.plan(s_);
+  const PressurePlan& plan = plan_;
+  if (plan.changes.empty()) return;
+  const std::string what = "the map changes " + std::to_string(plan.changes.size()) +
+                           " pressure(s) (channel and column) of schedule " + (s_.source.empty() ? s_.name : s_.source);
+  if (!opt_.allow_map_override)
+    throw InputError(map_.source, "refused before sending anything: " + what + ":\n" + plan.describe_changes() +
+                                      "give --allow-map-override to play them as listed");
+  std::string list = plan.describe_changes();
+  list.pop_back();  // say() ends the line
+  say(map_.source + ": " + what + " (--allow-map-override):\n" + list);
+}
+
+void Run::build_regulators() {
+  for (auto& [device, path] : opt_.ports)
+    if (!device.empty() && !map_.device(device))
+      throw InputError("--port " + device + "=" + path,
+                       "the map " + map_.source + " has no device named '" + device + "'");
   for (int ch = 0; ch < kNumChannels; ++ch) {
-    const ChannelSpec* c = map.find(ch);
+    const ChannelSpec* c = map_.find(ch);
     if (!c) continue;
     Regulator r;
     r.spec = *c;
-    r.dev = *map.device(c->device);
-    auto ov = opt.ports.find(r.dev.name);
-    if (ov != opt.ports.end())
+    r.dev = *map_.device(c->device);
+    auto ov = opt_.ports.find(r.dev.name);
+    if (ov != opt_.ports.end())
       r.dev.port = ov->second;
-    else if (opt.ports.count(""))
-      r.dev.port = opt.ports.at("");
-    if (r.dev.port.empty() && !opt.dry_run)
+    else if (opt_.ports.count(""))
+      r.dev.port = opt_.ports.at("");
+    if (r.dev.port.empty() && !opt_.dry_run)
       throw InputError(r.dev.where, "device " + r.dev.name + " has no port (give one in the map or with --port)");
     Line* line = nullptr;
-    for (auto& l : lines)
+    for (auto& l : lines_)
       if (l->path == r.dev.port) line = l.get();
     if (!line) {
-      lines.push_back(std::make_unique<Line>());
-      line = lines.back().get();
+      lines_.push_back(std::make_unique<Line>());
+      line = lines_.back().get();
       line->path = r.dev.port;
       line->baud = r.dev.baud;
     }
     r.line = line;
-    regs.push_back(r);
+    regs_.push_back(r);
   }
+  const std::size_t n = regs_.size();
+  follow_.assign(n, 0.0);
+  cmd_.assign(n, 0.0);
+  meas_.assign(n, kNaN);
+  sent_t_.assign(n, kNaN);
+  read_t_.assign(n, kNaN);
+  off_since_.assign(n, kNaN);
+  off_samples_.assign(n, 0);
+  for (std::size_t i = 0; i < n; ++i) {
+    const int ch = regs_[i].spec.channel;
+    follow_[i] = ch == kChannelCore ? 0.0 : s_.target_pa(ch, -1, levels_);
+    WatchSettings w = opt_.watch;
+    if (regs_[i].spec.min_fill_rate_pa_per_s) w.min_rate_pa_per_s = *regs_[i].spec.min_fill_rate_pa_per_s;
+    watch_.emplace_back(w);
+  }
+}
+
+void Run::open_log() {
   std::vector<int> chans;
-  for (auto& r : regs) chans.push_back(r.spec.channel);
-
-  SignalGuard signals(opt.handle_signals);
-  CsvLog log(opt.log_path, chans);
+  for (auto& r : regs_) chans.push_back(r.spec.channel);
+  log_ = std::make_unique<CsvLog>(opt_.log_path, chans);
+  CsvLog& log = *log_;
   log.meta("morphfem hw log", "v1");
-  log.meta("schedule", schedule.source.empty() ? schedule.name : schedule.source);
-  log.meta("map", map.source);
-  log.meta("column_s", std::to_string(schedule.column_s));
-  log.meta("columns", std::to_string(schedule.columns()));
-  log.meta("repeats", std::to_string(schedule.repeats));
-  log.meta("mode", opt.mode == Mode::fixed ? "fixed" : opt.mode == Mode::settle ? "settle" : "step");
-  log.meta("time_scale", std::to_string(opt.time_scale));
-  log.meta("dry_run", opt.dry_run ? "yes" : "no");
+  log.meta("schedule", s_.source.empty() ? s_.name : s_.source);
+  log.meta("map", map_.source);
+  log.meta("column_s", std::to_string(s_.column_s));
+  log.meta("columns", std::to_string(s_.columns()));
+  log.meta("repeats", std::to_string(s_.repeats));
+  log.meta("mode", opt_.mode == Mode::fixed ? "fixed" : opt_.mode == Mode::settle ? "settle" : "step");
+  log.meta("time_scale", std::to_string(opt_.time_scale));
+  log.meta("dry_run", opt_.dry_run ? "yes" : "no");
+  std::istringstream changes(plan_.describe_changes());  // played with --allow-map-override
+  for (std::string line; std::getline(changes, line);) log.meta("map_change", line.substr(line.find_first_not_of(' ')));
   log.header();
+}
 
-  const int K = schedule.total_columns();
-  int k = -1;      // current column; -1 = settling before column 0
-  double tau = 0;  // schedule time spent in the current column
-  double t = -schedule.settle_s;
-  const double tol_default = 2000;
-
-  std::vector<double> follow(regs.size()), cmd(regs.size(), 0.0), meas(regs.size(), kNaN);
-  std::vector<double> off_since(regs.size(), kNaN);
-  std::vector<int> off_samples(regs.size(), 0);  // consecutive exchanges out of the band
-  auto rates = [&](std::size_t i, double& rise, double& fall) {
-    int ch = regs[i].spec.channel;
-    const ChannelLevels& l = levels[ch];
-    if (ch == kChannelCore) {
-      rise = (l.inflate_ramp_s > 0 && l.inflate_pa != 0) ? std::abs(l.inflate_pa) / l.inflate_ramp_s
-                                                         : std::numeric_limits<double>::infinity();
-      fall = rise;
-    } else {
-      rise = l.rise_rate();
-      fall = l.fall_rate();
+// Opens every port and initialises every regulator; no setpoint is sent. On a
+// failure the ports are closed and the run ends: nothing was sent.
+bool Run::start_devices() {
+  try {
+    for (auto& l : lines_) {
+      l->port = std::make_unique<SerialPort>(l->path, l->baud);
+      l->port->open();
+      for (auto& r : regs_)
+        if (r.line == l.get()) r.init(opt_.reply_timeout_s);
     }
-  };
-  for (std::size_t i = 0; i < regs.size(); ++i)
-    follow[i] = regs[i].spec.channel == kChannelCore ? 0.0 : schedule.target_pa(regs[i].spec.channel, -1, levels);
+    log_->event(t_, k_, "event", "regulators initialised");
+    return true;
+  } catch (const DeviceError& e) {
+    for (auto& l : lines_)
+      if (l->port) l->port->close();
+    fail(kExitInput, std::string("could not start: ") + e.what() +
+                         "; nothing was sent (no regulator received a setpoint), nothing to vent");
+    return false;
+  }
+}
 
-  auto say = [&](const std::string& m) { err << "morphfem hw: " << m << "\n" << std::flush; };
+void Run::print_dry_run_init() {
+  out_ << "# dry run: command stream of " << (s_.source.empty() ? s_.name : s_.source) << "\n";
+  for (auto& r : regs_)
+    if (r.dev.protocol == Protocol::booth)
+      out_ << "init " << channel_name(r.spec.channel) << " " << r.dev.name << " " << hex_bytes(r.booth_init_request())
+           << "\n";
+}
 
-  // ---- 2. Open ports and initialise regulators. -------------------------------
-  auto io_timeout = opt.reply_timeout_s;
-  std::string fault;
-  int code = kExitOk;
-  auto init_line = [&](Line& l) {
-    for (auto& r : regs)
-      if (r.line == &l) r.init(io_timeout);
-  };
-  auto reconnect = [&](Line& l, const std::string& why) -> bool {
-    log.event(t, k, "event", "port " + l.path + " lost (" + why + "); reconnecting");
-    if (!l.port->reconnect(opt.reconnect_s)) return false;
+bool Run::stop_requested() {
+  const int sig = g_stop_signal.load();
+  if (!sig) return false;
+  fail(sig == SIGTERM ? kExitSigterm : kExitSigint,
+       std::string("stopped by ") + (sig == SIGTERM ? "SIGTERM" : "SIGINT"));
+  return true;
+}
+
+// Schedule seconds since the previous tick (0 on the first: its commands go out at the start).
+double Run::next_dt() {
+  if (!started_) {
+    started_ = true;
+    last_wall_ = wall_s();
+    return 0;
+  }
+  if (opt_.dry_run) return tick_s_ * opt_.time_scale;
+  const double next = last_wall_ + tick_s_;
+  double now = wall_s();
+  if (next > now) std::this_thread::sleep_for(std::chrono::duration<double>(next - now));
+  now = wall_s();
+  const double dt = (now - last_wall_) * opt_.time_scale;
+  last_wall_ = now;
+  return dt;
+}
+
+void Run::enter_column(int k) {
+  k_ = k;
+  tau_ = 0;
+  if (k_ >= K_)
+    finished_ = true;
+  else
+    pending_columns_.push_back({k_, t_});
+}
+
+// Advances the column clock and the ramp followers by dt schedule seconds.
+void Run::advance(double dt) {
+  const double inf = std::numeric_limits<double>::infinity();
+  double remaining = dt;
+  while (remaining > 0 && !finished_) {
+    double len = inf;  // settle and step modes advance on events
+    if (opt_.mode == Mode::fixed) len = k_ < 0 ? s_.settle_s : s_.column_s;
+    const double step = std::min(remaining, std::max(0.0, len - tau_));
+    for (std::size_t i = 0; i < regs_.size(); ++i) {
+      const int ch = regs_[i].spec.channel;
+      double rise = levels_[ch].rise_rate(), fall = levels_[ch].fall_rate();
+      if (ch == kChannelCore) {
+        const ChannelLevels& l = levels_[ch];
+        rise = (l.inflate_ramp_s > 0 && l.inflate_pa != 0) ? std::abs(l.inflate_pa) / l.inflate_ramp_s : inf;
+        fall = rise;
+      }
+      follow_[i] = ramp_towards(follow_[i], s_.target_pa(ch, k_, levels_), rise, fall, step);
+    }
+    tau_ += step;
+    t_ += step;
+    remaining -= step;
+    if (tau_ < len - 1e-12) break;
+    enter_column(k_ + 1);
+  }
+}
+
+// Commands: the followers, slew-limited by the map's ramp limit and clamped to its limits.
+void Run::update_commands(double dt) {
+  for (std::size_t i = 0; i < regs_.size(); ++i) {
+    const ChannelSpec& c = regs_[i].spec;
+    const double lim = c.ramp_limit_pa_per_s > 0 ? c.ramp_limit_pa_per_s : std::numeric_limits<double>::infinity();
+    cmd_[i] = std::clamp(ramp_towards(cmd_[i], follow_[i], lim, lim, dt), c.min_pa, c.max_pa);
+  }
+}
+
+void Run::exchange_dry_run() {
+  for (std::size_t i = 0; i < regs_.size(); ++i) {
+    if (std::abs(cmd_[i] - regs_[i].sent) <= 0.5) continue;
+    out_ << "t=" << std::fixed;
+    out_.precision(3);
+    out_ << (t_ == 0 ? 0.0 : t_) << " " << channel_name(regs_[i].spec.channel) << " " << regs_[i].dev.name << " tx "
+         << regs_[i].wire_command(cmd_[i]) << "\n";
+    out_.unsetf(std::ios::fixed);
+    regs_[i].sent = cmd_[i];
+  }
+  for (auto& [k, t] : pending_columns_) log_->event(t, k, "event", "column " + std::to_string(k + 1));
+  pending_columns_.clear();
+}
+
+bool Run::reconnect(Line& l, const std::string& why) {
+  log_->event(t_, k_, "event", "port " + l.path + " lost (" + why + "); reconnecting");
+  if (!l.port->reconnect(opt_.reconnect_s)) return false;
+  try {
+    for (auto& r : regs_)
+      if (r.line == &l) r.init(opt_.reply_timeout_s);
+  } catch (const DeviceError&) {
+    return false;
+  }
+  log_->event(t_, k_, "event", "port " + l.path + " reconnected");
+  round_interrupted_ = true;
+  return true;
+}
+
+// Sends regulator i its command (or polls it) and reads its pressure; one reconnection.
+void Run::exchange_one(std::size_t i) {
+  Regulator& r = regs_[i];
+  for (int attempt = 0;; ++attempt) {
     try {
-      init_line(l);
-    } catch (const DeviceError&) {
+      sent_t_[i] = t_ + (wall_s() - last_wall_) * opt_.time_scale;
+      if (!(std::abs(cmd_[i] - r.sent) <= 0.5))
+        meas_[i] = r.command(cmd_[i], opt_.reply_timeout_s);
+      else
+        meas_[i] = r.poll(opt_.reply_timeout_s);
+      // The reading was taken within [sent_t_, read_t_] (schedule time): the host
+      // may have stalled since the tick began, or during the exchange.
+      read_t_[i] = t_ + (wall_s() - last_wall_) * opt_.time_scale;
+      return;
+    } catch (const DisconnectedError& e) {
+      if (attempt > 0 || !reconnect(*r.line, e.what()))
+        throw DisconnectedError(std::string(e.what()) + "; it did not come back within " +
+                                std::to_string(opt_.reconnect_s) + " s");
+    }
+  }
+}
+
+bool Run::exchange() {
+  try {
+    for (std::size_t i = 0; i < regs_.size(); ++i) exchange_one(i);
+    return true;
+  } catch (const TimeoutError& e) {
+    fail(kExitFault, std::string("reply timeout: ") + e.what());
+  } catch (const DisconnectedError& e) {
+    fail(kExitFault, std::string("device disconnected: ") + e.what());
+  } catch (const DeviceError& e) {
+    fail(kExitFault, std::string("error reply: ") + e.what());
+  }
+  return false;
+}
+
+// After a completed exchange round: a gap longer than max_gap_s since the previous
+// one loses every column it overlaps; otherwise the columns entered since are logged.
+bool Run::account_round() {
+  const bool gap = std::isfinite(last_round_t_) && t_ - last_round_t_ > opt_.max_gap_s;
+  const double from_t = last_round_t_;
+  const int from_k = last_round_k_;
+  last_round_t_ = t_;
+  last_round_k_ = k_;
+  if (!gap) {
+    for (auto& [k, t] : pending_columns_) log_->event(t, k, "event", "column " + std::to_string(k + 1));
+    pending_columns_.clear();
+    return true;
+  }
+  pending_columns_.clear();
+  lost_.push_back({from_k, k_, from_t, t_});
+  for (auto& w : watch_) w.reset();  // samples before the gap are no evidence
+  off_since_.assign(regs_.size(), kNaN);
+  off_samples_.assign(regs_.size(), 0);
+  const std::string msg = "lost " + lost_.back().text();
+  if (!opt_.continue_after_gap) {
+    fail(kExitLost, msg);
+    return false;
+  }
+  log_->event(t_, k_, "fault", msg + "; playing on (--continue-after-gap)");
+  say(msg + "; playing on (--continue-after-gap)");
+  return true;
+}
+
+// The schedule ended inside a gap: the columns since the last completed exchange are lost.
+void Run::account_end() {
+  if (!std::isfinite(last_round_t_) || t_ - last_round_t_ <= opt_.max_gap_s) return;
+  lost_.push_back({last_round_k_, K_ - 1, last_round_t_, t_});
+  const std::string msg = "lost " + lost_.back().text() + " at the end of the schedule";
+  if (!opt_.continue_after_gap) {
+    fail(kExitLost, msg);
+    return;
+  }
+  log_->event(t_, k_, "fault", msg);
+}
+
+// The slow backstop: |measured - commanded| > tracking_fault_pa for tracking_fault_s
+// and tracking_fault_samples consecutive exchanges.
+bool Run::tracking_fault(std::size_t i, double error) {
+  if (!(error > opt_.tracking_fault_pa)) {
+    off_since_[i] = kNaN;
+    off_samples_[i] = 0;
+    return false;
+  }
+  if (std::isnan(off_since_[i])) off_since_[i] = t_;
+  ++off_samples_[i];
+  return t_ - off_since_[i] >= opt_.tracking_fault_s && off_samples_[i] >= opt_.tracking_fault_samples;
+}
+
+// Rupture, leak and stuck-valve detection; records whether every channel settled.
+bool Run::watch_pressures() {
+  settled_ = true;
+  for (std::size_t i = 0; i < regs_.size(); ++i) {
+    const double e = std::abs(meas_[i] - cmd_[i]);
+    std::string why = watch_[i].add(sent_t_[i], read_t_[i], cmd_[i], meas_[i]);
+    if (why.empty() && tracking_fault(i, e))
+      why = "measured " + kpa(meas_[i]) + " kPa, commanded " + kpa(cmd_[i]) + " kPa for " +
+            seconds_text(t_ - off_since_[i]) + " s";
+    if (!why.empty()) {
+      fail(kExitFault,
+           "tracking fault on " + regs_[i].label() + ": " + why + " (ruptured bladder, leak or stuck valve?)");
       return false;
     }
-    log.event(t, k, "event", "port " + l.path + " reconnected");
-    return true;
-  };
+    const ChannelSpec& c = regs_[i].spec;
+    const double tol = c.tolerance_pa > 0 ? c.tolerance_pa : 2000;
+    const double target = std::clamp(s_.target_pa(c.channel, k_, levels_), c.min_pa, c.max_pa);
+    if (!(e <= tol) || std::abs(cmd_[i] - target) > 0.5) settled_ = false;
+  }
+  return true;
+}
 
-  if (!opt.dry_run) {
+// Settle mode: next column once settled and held; step mode: keys.
+void Run::step_modes() {
+  if (opt_.mode == Mode::settle) {
+    const bool hold_done = tau_ >= (k_ < 0 ? s_.settle_s : opt_.min_hold_s);
+    if ((settled_ || opt_.dry_run) && hold_done) {
+      log_->event(t_, k_ + 1, "event", "settled; column " + std::to_string(k_ + 2));
+      enter_column(k_ + 1);
+      pending_columns_.clear();
+    } else if (k_ >= 0 && tau_ > opt_.settle_timeout_s) {
+      fail(kExitFault, "pressures did not settle within " + std::to_string(opt_.settle_timeout_s) + " s in column " +
+                           std::to_string(k_ + 1));
+    }
+    return;
+  }
+  if (opt_.mode != Mode::step) return;
+  pollfd p{opt_.step_fd, POLLIN, 0};
+  if (::poll(&p, 1, 0) <= 0 || !(p.revents & (POLLIN | POLLHUP))) return;
+  char c = 0;
+  const ssize_t n = ::read(opt_.step_fd, &c, 1);
+  if (n <= 0 || c == 'q') {
+    stop_reason_ = "stopped by the user";
+    finished_ = true;
+  } else if (c == '\n' || c == ' ' || c == 'n') {
+    log_->event(t_, k_ + 1, "event", "step to column " + std::to_string(k_ + 2));
+    enter_column(k_ + 1);
+    pending_columns_.clear();
+  }
+}
+
+void Run::show() {
+  if (!opt_.display || wall_s() - last_display_ <= 0.25) return;
+  last_display_ = wall_s();
+  std::ostringstream d;
+  d << "\rt " << std::fixed;
+  d.precision(2);
+  d << t_ << " s col " << (k_ + 1) << "/" << K_ << " |";
+  for (std::size_t i = 0; i < regs_.size(); ++i)
+    d << " " << channel_name(regs_[i].spec.channel) << " " << kpa(cmd_[i]) << "/" << kpa(meas_[i]);
+  d << " kPa\033[K";
+  err_ << d.str() << std::flush;
+}
+
+// Vents one regulator (3 attempts), reopening a vanished port until `deadline` (wall s).
+bool Run::vent_one(Regulator& r, double deadline) {
+  for (int attempt = 0; attempt < 3; ++attempt) {
     try {
-      for (auto& l : lines) {
-        l->port = std::make_unique<SerialPort>(l->path, l->baud);
-        l->port->open();
-        init_line(*l);
+      if (!r.line->port || !r.line->port->is_open()) {
+        if (!r.line->port) r.line->port = std::make_unique<SerialPort>(r.line->path, r.line->baud);
+        if (!r.line->port->reconnect(std::max(0.05, deadline - wall_s()))) continue;
       }
-      log.event(t, k, "event", "regulators initialised");
-    } catch (const DeviceError& e) {
-      fault = std::string("could not start: ") + e.what();
-      code = kExitFault;
+      r.vent(opt_.reply_timeout_s);
+      return true;
+    } catch (const DisconnectedError&) {
+      r.line->port->close();
+    } catch (const DeviceError&) {
+      // A garbled or missing reply to a vent: try again.
     }
-  } else {
-    out << "# dry run: command stream of " << (schedule.source.empty() ? schedule.name : schedule.source) << "\n";
-    for (auto& r : regs)
-      if (r.dev.protocol == Protocol::booth)
-        out << "init " << channel_name(r.spec.channel) << " " << r.dev.name << " " << hex_bytes(r.booth_init_request())
-            << "\n";
   }
+  return false;
+}
 
-  // ---- 3. Play. ----------------------------------------------------------------
-  if (opt.mode == Mode::fixed && schedule.settle_s <= 0) {
-    k = 0;  // no settle phase: the first commands are column 1's
-    log.event(t, k, "event", "column 1");
+// Vents every channel; only a channel that was sent a pressure and whose vent
+// could not be confirmed counts as not vented.
+void Run::vent_all() {
+  if (opt_.dry_run) {
+    for (auto& r : regs_)
+      out_ << "vent " << channel_name(r.spec.channel) << " " << r.dev.name << " tx "
+           << (r.dev.protocol == Protocol::alicat ? escape_ascii(alicat_setpoint(char(r.spec.address), 0))
+                                                  : hex_bytes(r.booth_setpoint_request(0, booth::kStateVent)))
+           << "\n";
+    vent_msg_ = "all channels vented";
+    return;
   }
-  double last_wall = wall_s(), last_display = 0;
-  bool finished = false, first_tick = true;
-  std::string stop_reason;
-  while (code == kExitOk && !finished) {
-    if (int sig = g_stop_signal.load()) {
-      code = sig == SIGTERM ? kExitSigterm : kExitSigint;
-      fault = std::string("stopped by ") + (sig == SIGTERM ? "SIGTERM" : "SIGINT");
-      break;
-    }
-    double dt;
-    if (first_tick) {
-      dt = 0;  // the first commands go out at the start time
-      first_tick = false;
-      last_wall = wall_s();
-    } else if (opt.dry_run) {
-      dt = opt.tick_s * opt.time_scale;
-    } else {
-      double next = last_wall + opt.tick_s;
-      double now = wall_s();
-      if (next > now) std::this_thread::sleep_for(std::chrono::duration<double>(next - now));
-      now = wall_s();
-      dt = (now - last_wall) * opt.time_scale;
-      last_wall = now;
-    }
-    // Advance the column clock and the ramp followers.
-    double remaining = dt;
-    while (remaining > 0 && !finished) {
-      double len;
-      if (k < 0)
-        len = (opt.mode == Mode::fixed) ? schedule.settle_s : std::numeric_limits<double>::infinity();
-      else
-        len = (opt.mode == Mode::fixed) ? schedule.column_s : std::numeric_limits<double>::infinity();
-      if (k < 0 && opt.mode != Mode::fixed && schedule.settle_s > 0) len = std::numeric_limits<double>::infinity();
-      double step = std::min(remaining, std::max(0.0, len - tau));
-      for (std::size_t i = 0; i < regs.size(); ++i) {
-        double rise, fall;
-        rates(i, rise, fall);
-        follow[i] = ramp_towards(follow[i], schedule.target_pa(regs[i].spec.channel, k, levels), rise, fall, step);
-      }
-      tau += step;
-      t += step;
-      remaining -= step;
-      if (tau >= len - 1e-12) {
-        ++k;
-        tau = 0;
-        if (k >= K)
-          finished = true;
-        else if (opt.mode == Mode::fixed || k == 0)
-          log.event(t, k, "event", "column " + std::to_string(k + 1));
-      } else {
-        break;
-      }
-    }
-    if (finished) break;
-    // Commands: slew limit and hard limits.
-    for (std::size_t i = 0; i < regs.size(); ++i) {
-      const ChannelSpec& s = regs[i].spec;
-      double lim = s.ramp_limit_pa_per_s > 0 ? s.ramp_limit_pa_per_s : std::numeric_limits<double>::infinity();
-      cmd[i] = std::clamp(ramp_towards(cmd[i], follow[i], lim, lim, dt), s.min_pa, s.max_pa);
-    }
-    // Exchange with the regulators.
-    if (opt.dry_run) {
-      for (std::size_t i = 0; i < regs.size(); ++i)
-        if (!(std::abs(cmd[i] - regs[i].sent) <= 0.5)) {
-          out << "t=" << std::fixed;
-          out.precision(3);
-          out << (t == 0 ? 0.0 : t) << " " << channel_name(regs[i].spec.channel) << " " << regs[i].dev.name << " tx "
-              << regs[i].wire_command(cmd[i]) << "\n";
-          out.unsetf(std::ios::fixed);
-          regs[i].sent = cmd[i];
-        }
-    } else {
-      try {
-        for (std::size_t i = 0; i < regs.size(); ++i) {
-          for (int attempt = 0;; ++attempt) {
-            try {
-              if (!(std::abs(cmd[i] - regs[i].sent) <= 0.5))
-                meas[i] = regs[i].command(cmd[i], io_timeout);
-              else
-                meas[i] = regs[i].poll(io_timeout);
-              break;
-            } catch (const DisconnectedError& e) {
-              if (attempt > 0 || !reconnect(*regs[i].line, e.what()))
-                throw DisconnectedError(std::string(e.what()) + "; it did not come back within " +
-                                        std::to_string(opt.reconnect_s) + " s");
-            }
-          }
-        }
-      } catch (const TimeoutError& e) {
-        fault = std::string("reply timeout: ") + e.what();
-        code = kExitFault;
-      } catch (const DisconnectedError& e) {
-        fault = std::string("device disconnected: ") + e.what();
-        code = kExitFault;
-      } catch (const DeviceError& e) {
-        fault = std::string("error reply: ") + e.what();
-        code = kExitFault;
-      }
-    }
-    log.sample(t, k, cmd, meas);
-    if (code != kExitOk) break;
-    // Tracking fault (rupture, leak, stuck valve) and settle detection.
-    bool settled = true;
-    if (!opt.dry_run) {
-      for (std::size_t i = 0; i < regs.size(); ++i) {
-        double e = std::abs(meas[i] - cmd[i]);
-        if (e > opt.tracking_fault_pa) {
-          if (std::isnan(off_since[i])) off_since[i] = t;
-          ++off_samples[i];
-          if (t - off_since[i] >= opt.tracking_fault_s && off_samples[i] >= opt.tracking_fault_samples) {
-            std::ostringstream m;
-            m << "tracking fault on " << regs[i].label() << ": measured " << kpa(meas[i]) << " kPa, commanded "
-              << kpa(cmd[i]) << " kPa for " << (t - off_since[i]) << " s (ruptured bladder, leak or stuck valve?)";
-            fault = m.str();
-            code = kExitFault;
-            break;
-          }
-        } else {
-          off_since[i] = kNaN;
-          off_samples[i] = 0;
-        }
-        double tol = regs[i].spec.tolerance_pa > 0 ? regs[i].spec.tolerance_pa : tol_default;
-        double target =
-            std::clamp(schedule.target_pa(regs[i].spec.channel, k, levels), regs[i].spec.min_pa, regs[i].spec.max_pa);
-        if (!(e <= tol) || std::abs(cmd[i] - target) > 0.5) settled = false;
-      }
-    }
-    if (code != kExitOk) break;
-    if (opt.mode == Mode::settle) {
-      bool hold_done = tau >= (k < 0 ? schedule.settle_s : opt.min_hold_s);
-      if ((settled || opt.dry_run) && hold_done) {
-        log.event(t, k + 1, "event", "settled; column " + std::to_string(k + 2));
-        ++k;
-        tau = 0;
-        if (k >= K) finished = true;
-      } else if (k >= 0 && tau > opt.settle_timeout_s) {
-        fault = "pressures did not settle within " + std::to_string(opt.settle_timeout_s) + " s in column " +
-                std::to_string(k + 1);
-        code = kExitFault;
-      }
-    } else if (opt.mode == Mode::step) {
-      pollfd p{opt.step_fd, POLLIN, 0};
-      if (::poll(&p, 1, 0) > 0 && (p.revents & (POLLIN | POLLHUP))) {
-        char c = 0;
-        ssize_t n = ::read(opt.step_fd, &c, 1);
-        if (n <= 0 || c == 'q') {
-          stop_reason = "stopped by the user";
-          finished = true;
-        } else if (c == '\n' || c == ' ' || c == 'n') {
-          ++k;
-          tau = 0;
-          log.event(t, k, "event", "step to column " + std::to_string(k + 1));
-          if (k >= K) finished = true;
-        }
-      }
-    }
-    if (opt.display && wall_s() - last_display > 0.25) {
-      last_display = wall_s();
-      std::ostringstream d;
-      d << "\rt " << std::fixed;
-      d.precision(2);
-      d << t << " s col " << (k + 1) << "/" << K << " |";
-      for (std::size_t i = 0; i < regs.size(); ++i)
-        d << " " << channel_name(regs[i].spec.channel) << " " << kpa(cmd[i]) << "/" << kpa(meas[i]);
-      d << " kPa\033[K";
-      err << d.str() << std::flush;
-    }
+  const double deadline = wall_s() + opt_.vent_reconnect_s;
+  std::vector<std::string> unreached;
+  for (auto& r : regs_)
+    if (!vent_one(r, deadline)) (r.pressurised ? not_vented_ : unreached).push_back(channel_name(r.spec.channel));
+  for (auto& l : lines_)
+    if (l->port) l->port->close();
+  vent_msg_ = not_vented_.empty() ? "all channels vented" : "COULD NOT VENT";
+  for (auto& n : not_vented_) vent_msg_ += " " + n;
+  if (!not_vented_.empty()) vent_msg_ += ": vent them by hand";
+  if (!unreached.empty()) {
+    vent_msg_ += "; not reached (never sent a pressure):";
+    for (auto& n : unreached) vent_msg_ += " " + n;
   }
-  if (opt.display) err << "\n";
+}
 
-  // ---- 4. Vent every channel, whatever happened. --------------------------------
-  if (code != kExitOk)
-    log.event(t, k, "fault", fault);
+int Run::report() {
+  std::string summary;
+  for (auto& l : lost_) summary += (summary.empty() ? "lost " : "; lost ") + l.text();
+  if (code_ != kExitOk) {
+    say(fault_ + "; " + vent_msg_);
+    const bool fault = code_ == kExitFault || code_ == kExitLost;
+    return fault && !not_vented_.empty() ? kExitVentFailed : code_;
+  }
+  if (!summary.empty()) say("schedule played to the end with " + summary + "; " + vent_msg_);
+  if (!not_vented_.empty()) {
+    say(vent_msg_);
+    return kExitVentFailed;
+  }
+  if (!opt_.dry_run && opt_.display && summary.empty())
+    say((stop_reason_.empty() ? "schedule complete" : stop_reason_) + "; " + vent_msg_);
+  return kExitOk;
+}
+
+int Run::execute() {
+  check_input();
+  build_regulators();
+  SignalGuard signals(opt_.handle_signals);
+  open_log();
+  K_ = s_.total_columns();
+  t_ = -s_.settle_s;
+  if (opt_.dry_run)
+    print_dry_run_init();
+  else if (!start_devices()) {
+    log_->event(t_, k_, "fault", fault_);
+    log_->close();
+    say(fault_);
+    return code_;
+  }
+  if (opt_.mode == Mode::fixed && s_.settle_s <= 0) enter_column(0);  // no settle phase: column 1 first
+  while (!finished_ && !stop_requested()) {
+    const double dt = next_dt();
+    advance(dt);
+    if (finished_) break;
+    update_commands(dt);
+    if (opt_.dry_run) {
+      exchange_dry_run();
+    } else {
+      const bool ok = exchange();
+      log_->sample(t_, k_, cmd_, meas_);
+      if (!ok) break;
+      // A round interrupted by a reconnection read some pressures late: it neither
+      // closes a gap nor feeds the detectors; the next round does.
+      const bool interrupted = round_interrupted_;
+      round_interrupted_ = false;
+      if (!interrupted && (!account_round() || !watch_pressures())) break;
+    }
+    step_modes();
+    if (code_ != kExitOk) break;
+    show();
+  }
+  if (opt_.display) err_ << "\n";
+  if (finished_ && code_ == kExitOk && !opt_.dry_run) account_end();
+  if (code_ != kExitOk)
+    log_->event(t_, k_, "fault", fault_);
   else
-    log.event(t, k, "event", stop_reason.empty() ? "end of schedule" : stop_reason);
-  std::vector<std::string> not_vented;
-  if (opt.dry_run) {
-    for (auto& r : regs)
-      out << "vent " << channel_name(r.spec.channel) << " " << r.dev.name << " tx "
-          << (r.dev.protocol == Protocol::alicat ? escape_ascii(alicat_setpoint(char(r.spec.address), 0))
-                                                 : hex_bytes(r.booth_setpoint_request(0, booth::kStateVent)))
-          << "\n";
-  } else {
-    const double vent_deadline = wall_s() + opt.vent_reconnect_s;
-    for (auto& r : regs) {
-      bool ok = false;
-      for (int attempt = 0; attempt < 3 && !ok; ++attempt) {
-        try {
-          if (!r.line->port || !r.line->port->is_open()) {
-            if (!r.line->port) r.line->port = std::make_unique<SerialPort>(r.line->path, r.line->baud);
-            // Wait for a vanished port, for vent_reconnect_s in total over all channels.
-            if (!r.line->port->reconnect(std::max(0.05, vent_deadline - wall_s()))) continue;
-          }
-          r.vent(io_timeout);
-          ok = true;
-        } catch (const DisconnectedError&) {
-          r.line->port->close();
-        } catch (const DeviceError&) {
-          // A garbled or missing reply to a vent: try again.
-        }
-      }
-      if (!ok) not_vented.push_back(channel_name(r.spec.channel));
-    }
-    for (auto& l : lines)
-      if (l->port) l->port->close();
-  }
-  std::string vent_msg;
-  if (not_vented.empty()) {
-    vent_msg = "all channels vented";
-  } else {
-    vent_msg = "COULD NOT VENT";
-    for (auto& n : not_vented) vent_msg += " " + n;
-    vent_msg += ": vent them by hand";
-  }
-  log.event(t, k, not_vented.empty() ? "event" : "fault", vent_msg);
-  log.close();
-  if (code != kExitOk) {
-    say(fault + "; " + vent_msg);
-    if (!not_vented.empty() && code == kExitFault) code = kExitVentFailed;
-  } else if (!not_vented.empty()) {
-    say(vent_msg);
-    code = kExitVentFailed;
-  } else if (!opt.dry_run && opt.display) {
-    say((stop_reason.empty() ? "schedule complete" : stop_reason) + "; " + vent_msg);
-  }
-  return code;
+    log_->event(t_, k_, "event", stop_reason_.empty() ? "end of schedule" : stop_reason_);
+  vent_all();
+  log_->event(t_, k_, not_vented_.empty() ? "event" : "fault", vent_msg_);
+  log_->close();
+  return report();
+}
+
+}  // namespace
+
+void request_stop(int signal_number) { g_stop_signal.store(signal_number); }
+
+int play(const Schedule& schedule, const ChannelMap& map, const PlayerOptions& options) {
+  return Run(schedule, map, options).execute();
 }
 
 }  // namespace morphfem::hw
