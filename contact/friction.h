@@ -111,7 +111,6 @@ class FrictionTerm : public EnergyTerm {
     u0_[k] = u0;
   }
   void set_step_length(double h) { h_ = h; }
-  double lagged_normal_force(int k) const { return lambda_[k]; }
 
   // Per mesh node, identical on every rank (collective): friction force on the
   // node [N], status (0: no normal force, 1: stick = slip velocity below eps_v,

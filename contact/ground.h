@@ -89,7 +89,6 @@ class GroundContactTerm : public EnergyTerm {
   // resting body at this gap to start it in equilibrium (a body started closer is
   // pushed off, one started farther falls onto the plane).
   double resting_gap(double pressure) const;
-  const std::vector<int>& owned_nodes() const { return owned_nodes_; }
   const std::vector<int>& contact_nodes() const { return all_nodes_; }  // every rank, sorted
 
   // Per mesh node, identical on every rank (collective): the force of the plane

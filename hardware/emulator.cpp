@@ -185,11 +185,6 @@ void Emulator::stop() {
     if (!d->down) close_pty(*d);
 }
 
-void Emulator::run_until(const std::atomic<bool>& stop_flag) {
-  while (!stop_flag && !stop_) std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  stop();
-}
-
 double Emulator::emulated_time() const {
   std::lock_guard<std::mutex> lock(mu_);
   return t_emu_;

@@ -92,8 +92,6 @@ class Emulator {
   // device name -> path the player should open (the link if configured).
   std::map<std::string, std::string> start();
   void stop();
-  // Runs until *stop_flag becomes true (for `morphfem hw emulate`).
-  void run_until(const std::atomic<bool>& stop_flag);
 
   std::vector<EmulatedChannelState> snapshot() const;
   EmulatedChannelState channel(int ch) const;

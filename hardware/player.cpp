@@ -812,7 +812,6 @@ int Run::execute() {
 
 }  // namespace
 
-void request_stop(int signal_number) { g_stop_signal.store(signal_number); }
 
 int play(const Schedule& schedule, const ChannelMap& map, const PlayerOptions& options) {
   return Run(schedule, map, options).execute();

@@ -68,7 +68,4 @@ struct PlayerOptions {
 // (nothing sent) if the schedule, the map or an option is refused.
 int play(const Schedule& schedule, const ChannelMap& map, const PlayerOptions& options);
 
-// For tests: raise the player's stop flag as SIGINT/SIGTERM would.
-void request_stop(int signal_number);
-
 }  // namespace morphfem::hw

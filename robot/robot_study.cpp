@@ -243,6 +243,10 @@ void register_robot_fitness() {
       "finite-element robot, voxel-study preset with growth actuation (levels: morphfem robot levels)");
 }
 
+std::string case_folder(const RobotCase& c, const RobotFidelity& level) {
+  return c.name + (c.physical ? "_physical" : c.lattice_mechanics ? "_lattice_L" + level.name : "_L" + level.name);
+}
+
 std::vector<CaseOutcome> run_robot_jobs(const std::vector<std::pair<RobotCase, RobotFidelity>>& jobs,
                                         const std::string& out_dir, MPI_Comm comm) {
   int rank = 0, size = 1;
@@ -253,11 +257,7 @@ std::vector<CaseOutcome> run_robot_jobs(const std::vector<std::pair<RobotCase, R
   int done_here = 0;
   const std::vector<double> all = run_jobs_over_ranks(n, CaseOutcome::kFields, comm, [&](int j, double* row) {
     const auto& [c, level] = jobs[j];
-    const std::string dir = out_dir.empty() ? ""
-                                            : out_dir + "/" + c.name +
-                                                  (c.physical            ? "_physical"
-                                                   : c.lattice_mechanics ? "_lattice_L" + level.name
-                                                                         : "_L" + level.name);
+    const std::string dir = out_dir.empty() ? "" : out_dir + "/" + case_folder(c, level);
     const SimulationResult r = run_robot_case(c, level, dir, PETSC_COMM_SELF, false);
     const double values[CaseOutcome::kFields] = {r.speed_bl_per_s,
                                                  r.gait_displacement_m,

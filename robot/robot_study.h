@@ -126,6 +126,9 @@ struct CaseOutcome {
   double speed = 0, displacement = 0, wall_s = 0, dofs = 0, steps = 0, newton = 0, completed = 0;
   static constexpr int kFields = 7;
 };
+// The folder of a case's results: NAME_LLEVEL, NAME_lattice_LLEVEL (lattice-mechanics
+// preset) or NAME_physical.
+std::string case_folder(const RobotCase& c, const RobotFidelity& level);
 // Runs jobs (case, level) round-robin over the ranks of `comm`, one rank per job, each
 // writing into OUT_DIR/NAME_LLEVEL (physical cases: OUT_DIR/NAME_physical; nothing if
 // out_dir is empty); every rank returns every outcome, in job order. A progress bar

@@ -78,10 +78,15 @@ struct FrictionDragOptions {
 };
 int robot_friction_drag(const FrictionDragOptions& options, MPI_Comm comm);
 
-// The wall time of each hand-designed gait on one rank, beside the voxel simulator's.
+// Each hand-designed gait on this one rank: wall time, dofs, steps, Newton iterations,
+// factorisations, the speed against its preset's reference at that level, and the
+// split of the time (Hessian, factorisation, solves, line search, gradient, output);
+// with `profile`, every logged event (fem/profile.h). benchmark.json holds it all.
 struct BenchmarkOptions {
   std::string fidelity = "0";
   std::vector<std::string> presets = {"voxel", "physical"};
+  std::vector<std::string> gaits = {"roll_flat", "roll_hill15", "inch_flat", "inch_hill15"};
+  bool profile = false;
 };
 int robot_benchmark(const BenchmarkOptions& options, MPI_Comm comm);
 

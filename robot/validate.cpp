@@ -1,5 +1,5 @@
-// `morphfem robot validate` and `robot benchmark` (robot/studies.h): the voxel study's
-// baselines on each preset, as a table and validation.json.
+// `morphfem robot validate` (robot/studies.h): the voxel study's baselines on each
+// preset, as a table and validation.json; `robot levels`.
 #include <cstdio>
 #include <filesystem>
 #include <string>
@@ -183,19 +183,6 @@ int robot_validate(const ValidateOptions& o, MPI_Comm comm) {
       "CASE_lattice_L%s/)\n",
       o.out_dir.c_str(), o.out_dir.c_str(), level.name.c_str(), level.name.c_str());
   return 0;
-}
-
-int robot_benchmark(const BenchmarkOptions& o, MPI_Comm comm) {
-  int size = 1;
-  MPI_Comm_size(comm, &size);
-  if (size != 1) throw InputError("morphfem robot benchmark", "times one rank per gait: run it without mpirun");
-  std::printf("voxel simulator (Voxelyze, 1428 voxels, 186,719 explicit steps, one thread): 136-145 s per gait\n");
-  ValidateOptions v;
-  v.fidelity = o.fidelity;
-  v.cases = {"roll_flat", "roll_hill15", "inch_flat", "inch_hill15"};
-  v.presets = o.presets;
-  v.out_dir = "results/robot/benchmark_L" + o.fidelity;
-  return robot_validate(v, comm);
 }
 
 int robot_levels() {

@@ -248,32 +248,3 @@ TEST(VerifyGas, QuickValveFillTimesScale) {
   EXPECT_NEAR(out[0].value / out[1].value, 2.0, 0.02);  // doubling C halves the fill time
   EXPECT_NEAR(out[0].value / out[2].value, std::log(5.0 / 4.0) / std::log(10.0 / 9.0), 0.02);
 }
-
-// Full ladders (minutes): run with --gtest_also_run_disabled_tests; prints JSON lines.
-TEST(VerifyGas, DISABLED_FullLadders) {
-  VerifyOptions opt;
-  opt.progress = false;
-  const char* which = std::getenv("GAS_CASE");
-  std::string w = which ? which : "";
-  if (w.size() > 6 && w.substr(w.size() - 6) == "_quick") {
-    opt.quick = true;
-    w = w.substr(0, w.size() - 6);
-  }
-  std::vector<VerificationRecord> out;
-  if (w.empty() || w == "sphere") gas_thick_sphere_case(opt, PETSC_COMM_WORLD, out);
-  if (w.empty() || w == "balloon") gas_balloon_case(opt, PETSC_COMM_WORLD, out);
-  if (w.empty() || w == "mooney") gas_mooney_balloon_case(opt, PETSC_COMM_WORLD, out);
-  if (w.empty() || w == "failure") gas_pressure_control_failure_case(opt, PETSC_COMM_WORLD, out);
-  if (w.empty() || w == "valve") gas_valve_case(opt, PETSC_COMM_WORLD, out);
-  if (w == "quick") {
-    opt.quick = true;
-    gas_thick_sphere_case(opt, PETSC_COMM_WORLD, out);
-    gas_balloon_case(opt, PETSC_COMM_WORLD, out);
-    gas_mooney_balloon_case(opt, PETSC_COMM_WORLD, out);
-    gas_pressure_control_failure_case(opt, PETSC_COMM_WORLD, out);
-    gas_valve_case(opt, PETSC_COMM_WORLD, out);
-  }
-  for (const auto& r : out) std::printf("%s\n", r.json().c_str());
-  if (w == "diagnostic")
-    std::printf("%s\n", run_pressure_controlled_balloon(true, PETSC_COMM_WORLD).stats.failure.c_str());
-}
