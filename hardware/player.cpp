@@ -812,7 +812,6 @@ int Run::execute() {
 
 }  // namespace
 
-
 int play(const Schedule& schedule, const ChannelMap& map, const PlayerOptions& options) {
   return Run(schedule, map, options).execute();
 }
