@@ -203,45 +203,25 @@ int morphing(const Args& args, MPI_Comm comm) {
   return calibrate_morphing(o, comm);
 }
 
-struct Subcommand {
-  const char* name;
-  const char* summary;
-  std::function<int(const Args&, MPI_Comm)> run;
-};
-
-const std::vector<Subcommand>& subcommands() {
-  static const std::vector<Subcommand> table = {
-      {"pull-tests", "friction coefficients of test-machine pull tests, statistics per group", pull_tests},
-      {"synth-pull", "synthetic pull-test exports with known coefficients", synth_pull},
-      {"drag", "a simulated pull test written as an export", drag},
-      {"friction", "mu_static, mu_kinetic and stiffness fitted with the simulator", friction},
-      {"materials", "hyperelastic fits to tensile exports, calibration file", materials},
-      {"morphing", "the core valve's conductances from the morphing times", morphing},
+// The subcommands, each run on this command's communicator.
+std::vector<Subcommand> subcommands(MPI_Comm comm) {
+  auto with = [comm](int (*run)(const Args&, MPI_Comm)) {
+    return [run, comm](const Args& args) { return run(args, comm); };
   };
-  return table;
-}
-
-std::string calibrate_usage() {
-  std::string out = "usage: morphfem calibrate COMMAND [options]\ncommands:\n";
-  for (const Subcommand& s : subcommands()) {
-    char line[160];
-    std::snprintf(line, sizeof line, "  %-11s %s\n", s.name, s.summary);
-    out += line;
-  }
-  return out + "morphfem calibrate COMMAND --help tells a command's options.\n";
+  return {
+      {"pull-tests", "friction coefficients of test-machine pull tests, statistics per group", with(pull_tests)},
+      {"synth-pull", "synthetic pull-test exports with known coefficients", with(synth_pull)},
+      {"drag", "a simulated pull test written as an export", with(drag)},
+      {"friction", "mu_static, mu_kinetic and stiffness fitted with the simulator", with(friction)},
+      {"materials", "hyperelastic fits to tensile exports, calibration file", with(materials)},
+      {"morphing", "the core valve's conductances from the morphing times", with(morphing)},
+  };
 }
 
 }  // namespace
 
 int calibrate_command(const std::vector<std::string>& args, MPI_Comm comm) {
-  if (args.empty() || args[0] == "--help" || args[0] == "-h") {
-    std::fputs(calibrate_usage().c_str(), args.empty() ? stderr : stdout);
-    return args.empty() ? 2 : 0;
-  }
-  const Args rest(args.begin() + 1, args.end());
-  for (const Subcommand& s : subcommands())
-    if (args[0] == s.name) return s.run(rest, comm);
-  throw InputError("morphfem calibrate", "unknown command '" + args[0] + "'\n" + calibrate_usage());
+  return run_subcommand("morphfem calibrate", subcommands(comm), args, std::cout, std::cerr);
 }
 
 }  // namespace morphfem

@@ -206,48 +206,28 @@ int levels(const Args& args, MPI_Comm) {
   return robot_levels();
 }
 
-struct Subcommand {
-  const char* name;
-  const char* summary;
-  std::function<int(const Args&, MPI_Comm)> run;
-};
-
-const std::vector<Subcommand>& subcommands() {
-  static const std::vector<Subcommand> table = {
-      {"validate", "the voxel study's baselines on each preset", validate},
-      {"ladder", "one case on several fidelity levels", ladder},
-      {"spread", "one case under a perturbation ensemble", spread},
-      {"morph", "shape change under core pressure", morph},
-      {"friction-sweep", "inching against the feet's friction", friction_sweep},
-      {"friction-drag", "the pull test on a robot scene", friction_drag},
-      {"benchmark", "wall time of each gait against the voxel simulator", benchmark},
-      {"scene", "the scene file of one case, for morphfem run", scene},
-      {"levels", "the fidelity levels", levels},
+// The subcommands, each run on this command's communicator.
+std::vector<Subcommand> subcommands(MPI_Comm comm) {
+  auto with = [comm](int (*run)(const Args&, MPI_Comm)) {
+    return [run, comm](const Args& args) { return run(args, comm); };
   };
-  return table;
-}
-
-std::string robot_usage() {
-  std::string out = "usage: morphfem robot COMMAND [options]\ncommands:\n";
-  for (const Subcommand& s : subcommands()) {
-    char line[160];
-    std::snprintf(line, sizeof line, "  %-15s %s\n", s.name, s.summary);
-    out += line;
-  }
-  return out + "morphfem robot COMMAND --help tells a command's options.\n";
+  return {
+      {"validate", "the voxel study's baselines on each preset", with(validate)},
+      {"ladder", "one case on several fidelity levels", with(ladder)},
+      {"spread", "one case under a perturbation ensemble", with(spread)},
+      {"morph", "shape change under core pressure", with(morph)},
+      {"friction-sweep", "inching against the feet's friction", with(friction_sweep)},
+      {"friction-drag", "the pull test on a robot scene", with(friction_drag)},
+      {"benchmark", "wall time of each gait against the voxel simulator", with(benchmark)},
+      {"scene", "the scene file of one case, for morphfem run", with(scene)},
+      {"levels", "the fidelity levels", with(levels)},
+  };
 }
 
 }  // namespace
 
 int robot_command(const std::vector<std::string>& args, MPI_Comm comm) {
-  if (args.empty() || args[0] == "--help" || args[0] == "-h") {
-    std::fputs(robot_usage().c_str(), args.empty() ? stderr : stdout);
-    return args.empty() ? 2 : 0;
-  }
-  const Args rest(args.begin() + 1, args.end());
-  for (const Subcommand& s : subcommands())
-    if (args[0] == s.name) return s.run(rest, comm);
-  throw InputError("morphfem robot", "unknown command '" + args[0] + "'\n" + robot_usage());
+  return run_subcommand("morphfem robot", subcommands(comm), args, std::cout, std::cerr);
 }
 
 }  // namespace morphfem

@@ -185,6 +185,35 @@ int CommandLine::integer(const std::string& name, int fallback, int lo, int hi) 
   return static_cast<int>(v);
 }
 
+namespace {
+
+std::string subcommand_usage(const std::string& command, const std::vector<Subcommand>& subcommands) {
+  size_t width = 0;
+  for (const Subcommand& s : subcommands) width = std::max(width, std::string(s.name).size());
+  std::string out = "usage: " + command + " COMMAND [options]\ncommands:\n";
+  for (const Subcommand& s : subcommands)
+    out += "  " + std::string(s.name) + std::string(width + 2 - std::string(s.name).size(), ' ') + s.summary + "\n";
+  return out + command + " COMMAND --help tells a command's options.\n";
+}
+
+}  // namespace
+
+int run_subcommand(const std::string& command, const std::vector<Subcommand>& subcommands,
+                   const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
+  if (args.empty()) {
+    err << subcommand_usage(command, subcommands);
+    return 2;
+  }
+  if (args[0] == "--help" || args[0] == "-h") {
+    out << subcommand_usage(command, subcommands);
+    return 0;
+  }
+  const std::vector<std::string> rest(args.begin() + 1, args.end());
+  for (const Subcommand& s : subcommands)
+    if (args[0] == s.name) return s.run(rest);
+  throw InputError(command, "unknown command '" + args[0] + "'\n" + subcommand_usage(command, subcommands));
+}
+
 double number_option(const std::string& command, const std::string& option, const std::string& text, double lo,
                      double hi) {
   double v;

@@ -10,6 +10,7 @@
 //     (`-snes_monitor`, `-ksp_type preonly`): a single-dash token and the bare token
 //     after it belong to PETSc, so positional arguments come first.
 #pragma once
+#include <functional>
 #include <map>
 #include <optional>
 #include <ostream>
@@ -65,6 +66,20 @@ class CommandLine {
   std::map<std::string, std::vector<std::string>> given_;
   std::vector<std::string> positional_;
 };
+
+// A command made of subcommands (`morphfem robot validate ...`): their names, one-line
+// summaries and what runs them on the words after the name.
+struct Subcommand {
+  const char* name;
+  const char* summary;
+  std::function<int(const std::vector<std::string>&)> run;
+};
+
+// Runs the subcommand args[0] names with the words after it. No argument: the list of
+// subcommands on `err`, status 2; --help or -h: the list on `out`, status 0; an unknown
+// name: InputError naming `command` ("morphfem robot") with the list.
+int run_subcommand(const std::string& command, const std::vector<Subcommand>& subcommands,
+                   const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
 
 // A numeric option in [lo, hi]; InputError naming "calibrate COMMAND" and the option
 // otherwise.
