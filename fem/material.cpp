@@ -89,17 +89,29 @@ std::unique_ptr<Material> make_silicone_preset(const ParamSet& params, const Sil
 
 }  // namespace
 
-const std::map<std::string, MaterialFactory>& material_registry() {
-  static const std::map<std::string, MaterialFactory> registry = {
-      {"neo_hookean", make_neo_hookean},
-      {"mooney_rivlin", make_mooney_rivlin},
-      {"yeoh", make_yeoh},
-      {"ogden", make_ogden},
-      {"fabric", make_fabric},
-      {"dragon_skin_10", [](const ParamSet& p) { return make_silicone_preset(p, kDragonSkin10); }},
-      {"dragon_skin_30", [](const ParamSet& p) { return make_silicone_preset(p, kDragonSkin30); }},
+// One line per law: its name, factory and example parameters [Pa].
+const std::map<std::string, MaterialLaw>& material_registry() {
+  static const std::map<std::string, MaterialLaw> registry = {
+      {"neo_hookean", {make_neo_hookean, {{"mu", {80e3}}, {"kappa", {2e6}}}}},
+      {"mooney_rivlin", {make_mooney_rivlin, {{"c10", {30e3}}, {"c01", {8e3}}, {"nu", {0.45}}}}},
+      {"yeoh", {make_yeoh, {{"c1", {21.6e3}}, {"c2", {3.0e3}}, {"c3", {-110.0}}, {"kappa", {1e6}}}}},
+      {"ogden", {make_ogden, {{"mu", {27e3}}, {"alpha", {3.13}}, {"kappa", {1e6}}}}},
+      {"fabric",
+       {make_fabric,
+        {{"mu", {1e5}}, {"nu", {0.3}}, {"fibre_modulus", {1e8}}, {"fibres", {1, 0, 0, 0, 1, 0, 1, 1, 0}}}}},
+      {"dragon_skin_10", {[](const ParamSet& p) { return make_silicone_preset(p, kDragonSkin10); }, {}}},
+      {"dragon_skin_30", {[](const ParamSet& p) { return make_silicone_preset(p, kDragonSkin30); }, {}}},
   };
   return registry;
+}
+
+ParamSet example_parameters(const std::string& name) {
+  const MaterialLaw& law = material_registry().at(name);
+  ParamSet p("material registry: " + name);
+  p.set_string("model", name);
+  for (const auto& [key, values] : law.example) p.set(key, values);
+  for (const auto& [key, text] : law.example_strings) p.set_string(key, text);
+  return p;
 }
 
 std::unique_ptr<Material> make_material(const ParamSet& params) {
@@ -110,7 +122,7 @@ std::unique_ptr<Material> make_material(const ParamSet& params) {
     throw InputError(params.where("model"),
                      "unknown material model '" + model + "' (known: " + join_keys(registry, ", ") + ")");
   }
-  return it->second(params);
+  return it->second.make(params);
 }
 
 }  // namespace morphfem

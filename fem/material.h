@@ -45,9 +45,26 @@ class Material {
   // Small-strain shear and bulk moduli [Pa] (for reporting, time steps, penalties).
   virtual double shear_modulus() const = 0;
   virtual double bulk_modulus() const = 0;
+  // Whether W is twice differentiable within h of F in every component of F. A law
+  // with kinks (the fabric's fibres going slack) says where they are, so that a
+  // finite-difference check of its tangent steps around them.
+  virtual bool smooth_near(const Mat3& F, double h) const { return F.allFinite() && h >= 0; }
+  // Whether the law is isotropic: at F = I its tangent is linear elasticity with
+  // shear_modulus() and bulk_modulus().
+  virtual bool isotropic() const { return true; }
 };
 
 using MaterialFactory = std::function<std::unique_ptr<Material>(const ParamSet&)>;
+
+// A law registered by name: its factory, and parameters it is valid with, with which
+// tests/fem/test_material_laws.cpp checks every registered law (stress and tangent
+// against finite differences, symmetry, objectivity, W = W_iso + U): registering a law
+// is what gets it checked.
+struct MaterialLaw {
+  MaterialFactory make;
+  std::vector<std::pair<std::string, std::vector<double>>> example;
+  std::vector<std::pair<std::string, std::string>> example_strings = {};
+};
 
 // name -> factory. Names: neo_hookean (mu, kappa), mooney_rivlin (c10, c01, kappa),
 // yeoh (c1, c2, c3, kappa), ogden (mu: [..], alpha: [..], kappa), fabric (a
@@ -57,7 +74,9 @@ using MaterialFactory = std::function<std::unique_ptr<Material>(const ParamSet&)
 // the presets, which default to nu = 0.49). Presets also take `law: yeoh`
 // (default) or `law: neo_hookean`; their coefficients are fits to the tensile data
 // in shared/data/materials over <= 200 % strain (see fem/material.cpp).
-const std::map<std::string, MaterialFactory>& material_registry();
+const std::map<std::string, MaterialLaw>& material_registry();
+// The registry's example parameters of law `name` (model = name) as a ParamSet.
+ParamSet example_parameters(const std::string& name);
 
 // Builds `params.string("model")`; unknown names and bad parameters throw InputError.
 std::unique_ptr<Material> make_material(const ParamSet& params);

@@ -30,6 +30,16 @@ class Fabric final : public Material {
   std::string name() const override { return "fabric"; }
   double shear_modulus() const override { return matrix_->shear_modulus(); }
   double bulk_modulus() const override { return matrix_->bulk_modulus(); }
+  bool isotropic() const override { return false; }
+  // A fibre's energy E_f/8 (I4 - 1)^2 for I4 > 1 has a kink in its second derivative at
+  // I4 = 1; I4 moves by at most 2 |F a| h + 3 h^2 when F moves by h per component.
+  bool smooth_near(const Mat3& F, double h) const override {
+    for (const auto& a : fibres_) {
+      const double reach = 2.0 * (F * a).norm() * 3.0 * h + 9.0 * h * h;
+      if (std::abs((F * a).squaredNorm() - 1.0) <= reach) return false;
+    }
+    return true;
+  }
 
   double energy(const Mat3& F) const override {
     double W = matrix_->energy(F);
