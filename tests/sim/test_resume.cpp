@@ -26,7 +26,7 @@ namespace fs = std::filesystem;
 namespace {
 
 // Friction, contact and implicit-Euler inertia (shared with kill_resume.cmake).
-const std::string kSlide = MORPHFEM_SOURCE_DIR "/tests/app/scenes/slide.yaml";
+const std::string kSlide = MORPHFEM_SOURCE_DIR "/tests/sim/scenes/slide.yaml";
 
 // A gas cavity fed through a valve, BDF2 inertia with Kelvin-Voigt damping.
 const char* kBalloon = R"(
