@@ -54,7 +54,7 @@
 //   contact:
 //     ground: {point: [0, 0, 0], normal: [0, 0, 1], surfaces: [zmin], dhat: 0, kappa: 0}
 //             # 0: defaults, dhat 1e-3 x box diagonal, kappa [Pa] 3 mu of the material under
-//             # most of the surfaces' area (contact_shear_modulus, sim/simulation.h)
+//             # most of the surfaces' area (contact_shear_modulus, sim/terms.h)
 //     friction: {eps_v: 1e-4, lag_updates: 0,
 //                regions: [{surface: zmin, mu_static: 0.5, mu_kinetic: 0.4}]}
 //                # mu: a number or a table [[t, mu], ...] (coefficients that change over time)

@@ -1,5 +1,8 @@
-// Runs a scene: builds the mesh and only the energy terms the scene declares,
-// solves in adaptive load steps, writes XDMF/HDF5 results and summary.json.
+// Runs a scene: builds the model (the mesh and only the energy terms the scene
+// declares: build_scene_mesh and build_model in sim/model.h, the term builders,
+// contact_shear_modulus and lattice_points in sim/terms.h), steps it in adaptive
+// load steps with checkpoints (sim/stepper.h), writes XDMF/HDF5 results and
+// summary.json (sim/observers.h).
 #pragma once
 #include <array>
 #include <functional>
@@ -12,7 +15,9 @@
 #include "fem/solver.h"
 #include "mesh/mesh.h"
 #include "mesh/partition.h"
+#include "sim/model.h"
 #include "sim/scene.h"
+#include "sim/terms.h"
 
 namespace morphfem {
 
@@ -63,30 +68,6 @@ struct RunOptions {
 // The scene document as checkpoints identify it: every key but solver.end_time and
 // output.checkpoint_s.
 std::string scene_identity(const YAML::Node& doc);
-
-// Shear modulus [Pa] of the material under most of the surfaces' area (each
-// boundary face takes the material of the cell it bounds; 0 if none). The
-// default contact barrier stiffness is E ~ 3 mu of the material a contact presses
-// into, not of the stiffest material in the body: with kappa 2,300x the skin's E
-// (the 100 MPa fabric sheet, whose 0.5 mm edges reach the outer surface, inside a
-// 43 kPa skin) a node entering the barrier rests within sqrt(p / 3 kappa) dhat of
-// its edge, where the barrier is nearly cubic, and Newton converges linearly
-// (residual / 4 per iteration) until it gets there.
-double contact_shear_modulus(const Mesh& mesh, const std::vector<std::shared_ptr<const Material>>& materials,
-                             const std::vector<std::string>& surfaces);
-
-// Builds the mesh the scene asks for on rank 0 and broadcasts it; checks every
-// region name the scene uses. Throws InputError on bad input before any output
-// directory is created.
-Mesh build_scene_mesh(const Scene& scene, MPI_Comm comm);
-
-// The lattice voxels of a robot_voxel scene with contact.lattice_floor as floor
-// contact points (contact/lattice_floor.h): the material point at each voxel box's
-// centre, its footprint, its sphere radius L (s_x + s_y + s_z)/6 growing with the
-// region's actuation.growth, and its friction coefficient: the region's, or for skin
-// voxels over a foot's y range (both layers, as the lattice's foot voxels) the
-// foot's mu(t) from actuation.feet. Throws InputError naming the scene key.
-std::vector<LatticePoint> lattice_points(const Scene& scene, const Mesh& mesh);
 
 // Runs the scene. A solve that fails after all step cuts returns with
 // stats.completed == false and stats.failure set; the last converged state is

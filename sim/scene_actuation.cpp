@@ -1,0 +1,252 @@
+// The actuation of a scene (a schedule played from `start` through bladder
+// cavities or the voxel study's growth, foot friction, valves) and its
+// environment (slope, heading, gravity, body length).
+#include <cmath>
+#include <filesystem>
+
+#include "actuation/schedule_loads.h"
+#include "actuation/voxel_growth.h"
+#include "sim/scene_reader.h"
+
+namespace morphfem {
+
+namespace {
+
+// The schedule: written inline (a mapping in the schedule file format) or a
+// file (relative to the scene).
+Schedule read_schedule_key(const SceneReader &r, const YAML::Node &a, Scene &scene) {
+  if (!a["schedule"]) r.fail(a, "actuation", "missing key 'schedule' (a schedule file)");
+  if (a["schedule"].IsMap()) {
+    YAML::Emitter text;
+    text << a["schedule"];
+    scene.schedule_file = r.at(a["schedule"]);
+    return parse_schedule(text.c_str(), scene.schedule_file + " (actuation.schedule)");
+  }
+  std::filesystem::path file = r.text(a["schedule"], "actuation.schedule");
+  if (file.is_relative()) file = std::filesystem::path(r.file).parent_path() / file;
+  scene.schedule_file = file.string();
+  return read_schedule(scene.schedule_file);  // its own errors name its file and line
+}
+
+// The keys of `actuation` after its schedule, read in the order of their
+// checks.
+struct ActuationReader {
+  ActuationReader(const SceneReader &r, const YAML::Node &a, Scene &scene, const Schedule &schedule)
+      : r(r), a(a), scene(scene), schedule(schedule) {}
+
+  const SceneReader &r;
+  const YAML::Node &a;
+  Scene &scene;
+  const Schedule &schedule;
+  const std::string key = "actuation";
+  const VoxelActuation voxel;
+  double start = 0.0;
+  std::string timing;  // "schedule" or "voxel"
+  std::array<bool, 3> axes{true, true, true};
+  bool valves = false;
+  GasCavitySpec valve;
+
+  void read_timing();
+  void read_growth();
+  void read_weightless();
+  void read_valves();
+  void add_cavity(int channel, const std::string &surface, const char *open_key, TimeFunction pressure);
+  void read_bladders();
+  void read_core();
+  void read_feet();
+};
+
+// The start, the timing and the gait they give.
+void ActuationReader::read_timing() {
+  start = a["start"] ? r.number(a["start"], key + ".start") : 0.0;
+  if (start < 0) r.fail(a["start"], key + ".start", "must be >= 0");
+  if (a["growth"] && a["bladders"]) r.fail(a["growth"], key + ".growth", "give either bladders or growth, not both");
+  timing = a["growth"] ? "voxel" : "schedule";
+  if (a["timing"]) {
+    timing = r.text(a["timing"], key + ".timing");
+    if (timing != "schedule" && timing != "voxel") r.fail(a["timing"], key + ".timing", "must be schedule or voxel");
+    if (a["growth"] && timing != "voxel")
+      r.fail(a["timing"], key + ".timing", "growth actuation runs on the voxel timing");
+  }
+  const double gait_s = timing == "voxel" ? voxel_timeline(schedule, voxel).duration() : schedule.duration();
+  scene.gait.enabled = true;
+  scene.gait.start = start;
+  scene.gait.end = start + gait_s;
+  scene.gait.nominal_s = schedule.duration();
+  // A run shorter than the gait plays only part of the schedule; its summary
+  // then says gait_complete: false and reports no speed.
+}
+
+void ActuationReader::read_growth() {
+  const auto g = a["growth"];
+  if (!g) return;
+  if (!g.IsMap()) r.fail(g, key + ".growth", "expected a map {b1: volume region, ...}");
+  for (const auto &kv : g) {
+    const std::string name = kv.first.as<std::string>();
+    const int channel = channel_index(name);
+    if (channel < 0 || channel >= kNumBladders)
+      r.fail(kv.first, key + ".growth." + name, "not a bladder channel (b1..b8)");
+    scene.growth.emplace_back(r.text(kv.second, key + ".growth." + name),
+                              voxel_bladder_growth(schedule, channel, start, schedule.core_pressure_pa, voxel));
+  }
+}
+
+void ActuationReader::read_weightless() {
+  if (const auto w = a["weightless_inflated"]) {
+    if (!a["growth"]) r.fail(w, key + ".weightless_inflated", "needs growth actuation");
+    scene.weightless_inflated = r.flag(w, key + ".weightless_inflated");
+  }
+}
+
+// actuation.valves: every scheduled cavity holds gas fed through a valve from
+// its regulator, whose output follows the schedule's setpoint (gas cavities,
+// actuation/gas_cavity.h), instead of being held at the setpoint itself.
+void ActuationReader::read_valves() {
+  const YAML::Node v = a["valves"];
+  valves = static_cast<bool>(v);
+  if (!valves) return;
+  const std::string vkey = key + ".valves";
+  if (!v.IsMap()) r.fail(v, vkey, "expected a map {fill_time_s: T} or {conductance: C}");
+  r.allow(v, vkey, {"fill_time_s", "conductance", "temperature"});
+  if (static_cast<bool>(v["fill_time_s"]) == static_cast<bool>(v["conductance"]))
+    r.fail(v, vkey, "give exactly one of fill_time_s [s] and conductance [mol/(s Pa)]");
+  auto positive = [&](const char *k) { return r.positive(v[k], vkey + "." + k, true); };
+  if (v["fill_time_s"]) valve.fill_time = positive("fill_time_s");
+  if (v["conductance"]) valve.conductance = TimeFunction::constant(positive("conductance"));
+  if (v["temperature"]) valve.temperature = positive("temperature");
+}
+
+// A channel's cavity; with actuation.<open_key> an open sleeve along that axis
+// (its volume axes the other two, whatever volume_axes says).
+void ActuationReader::add_cavity(int channel, const std::string &surface, const char *open_key, TimeFunction pressure) {
+  CavitySpec spec;
+  spec.name = channel_name(channel);
+  spec.surfaces = {surface};
+  spec.axes = axes;
+  spec.pressure = std::move(pressure);
+  if (a[open_key]) {
+    YAML::Node sleeve;
+    sleeve["open_axis"] = a[open_key];
+    r.open_axis(sleeve, key + "." + open_key, spec.axes, spec.open_axis);
+  }
+  if (!valves) {
+    scene.cavities.push_back(spec);
+    return;
+  }
+  GasCavitySpec gas = valve;  // starts at atmospheric pressure, the setpoint is the supply
+  gas.wall = {spec.name, spec.surfaces, spec.axes, 1.0, spec.open_axis};
+  gas.supply_gauge_pressure = spec.pressure;
+  scene.gas_cavities.push_back(gas);
+}
+
+void ActuationReader::read_bladders() {
+  if (const auto b = a["bladders"]) {
+    if (!b.IsMap()) r.fail(b, key + ".bladders", "expected a map {b1: surface, ...}");
+    for (const auto &kv : b) {
+      const std::string name = kv.first.as<std::string>();
+      const int channel = channel_index(name);
+      if (channel < 0 || channel >= kNumBladders)
+        r.fail(kv.first, key + ".bladders." + name, "not a bladder channel (b1..b8)");
+      // bladders_open_axis: chambers without end walls (a plane-strain slice)
+      add_cavity(channel, r.text(kv.second, key + ".bladders." + name), "bladders_open_axis",
+                 channel_pressure(schedule, channel, start));
+    }
+  } else if (a["bladders_open_axis"]) {
+    r.fail(a["bladders_open_axis"], key + ".bladders_open_axis", "needs 'bladders'");
+  }
+}
+
+void ActuationReader::read_core() {
+  if (a["core"]) {
+    TimeFunction core = channel_pressure(schedule, kChannelCore, start);
+    if (a["core_ramp_s"]) {  // the core rises linearly from 0 over [0,
+                             // core_ramp_s], then holds
+      const double ramp = r.number(a["core_ramp_s"], key + ".core_ramp_s");
+      if (!(ramp > 0) || ramp > start) r.fail(a["core_ramp_s"], key + ".core_ramp_s", "must be in (0, start]");
+      core = TimeFunction::ramp(schedule.core_pressure_pa, ramp);
+    }
+    add_cavity(kChannelCore, r.text(a["core"], key + ".core"), "core_open_axis", core);
+  } else if (a["core_ramp_s"] || a["core_open_axis"]) {
+    const char *k = a["core_ramp_s"] ? "core_ramp_s" : "core_open_axis";
+    r.fail(a[k], key + "." + k, "needs 'core'");
+  }
+}
+
+// Foot friction following the schedule: friction regions on the ground, or the
+// lattice floor's foot voxels.
+void ActuationReader::read_feet() {
+  const auto f = a["feet"];
+  if (!f) return;
+  r.allow(f, key + ".feet", {"foot_a", "foot_b", "mu_active", "mu_inactive"});
+  if (!scene.ground_contact && !scene.lattice_floor)
+    r.fail(f, key + ".feet", "foot friction needs contact.ground (or contact.lattice_floor)");
+  const double mu_active = f["mu_active"] ? r.calibrated_number(f["mu_active"], key + ".feet.mu_active") : 2.0;
+  const double mu_inactive = f["mu_inactive"] ? r.calibrated_number(f["mu_inactive"], key + ".feet.mu_inactive") : 1e-4;
+  // Ground contact: friction regions; the lattice floor only: its foot voxels.
+  scene.friction = scene.ground_contact;
+  for (const auto &[foot, channel] :
+       {std::pair<const char *, int>{"foot_a", kChannelFootA}, {"foot_b", kChannelFootB}}) {
+    if (!f[foot]) continue;
+    const TimeFunction mu = timing == "voxel"
+                                ? voxel_foot_friction(schedule, channel, start, mu_active, mu_inactive, voxel)
+                                : foot_friction(schedule, channel, start, mu_active, mu_inactive);
+    const std::string surface = r.text(f[foot], key + ".feet." + foot);
+    if (scene.ground_contact)
+      scene.friction_spec.regions.push_back({surface, mu, mu});
+    else
+      scene.lattice_floor_spec.feet.push_back({surface, mu});
+  }
+  LatticeFloorScene &lattice = scene.lattice_floor_spec;
+  if (lattice.gap_foot_columns && !scene.ground_contact) {
+    if (timing != "voxel")
+      r.fail(f, key + ".feet", "contact.lattice_floor.gap_foot_columns needs the voxel timing (growth actuation)");
+    lattice.gap_foot_mu = voxel_gap_foot_friction(schedule, start, mu_active, mu_inactive, voxel);
+  }
+}
+
+}  // namespace
+
+std::optional<Schedule> read_actuation(const SceneReader &r, const YAML::Node &a, Scene &scene) {
+  if (!a) return std::nullopt;
+  r.allow(a, "actuation",
+          {"schedule", "start", "bladders", "growth", "timing", "core", "core_ramp_s", "volume_axes", "core_open_axis",
+           "bladders_open_axis", "feet", "weightless_inflated", "valves"});
+  std::optional<Schedule> schedule = read_schedule_key(r, a, scene);
+  ActuationReader actuation(r, a, scene, *schedule);
+  actuation.read_timing();
+  actuation.read_growth();
+  actuation.read_weightless();
+  if (a["volume_axes"]) actuation.axes = r.axes(a["volume_axes"], "actuation.volume_axes");
+  actuation.read_valves();
+  actuation.read_bladders();
+  actuation.read_core();
+  actuation.read_feet();
+  return schedule;
+}
+
+void read_environment(const SceneReader &r, const YAML::Node &root, const std::optional<Schedule> &schedule,
+                      Scene &scene) {
+  const auto e = root["environment"];
+  if (!e) return;
+  const std::string key = "environment";
+  r.allow(e, key, {"slope_deg", "heading_deg", "gravity", "body_length"});
+  if (root["loads"] && root["loads"]["gravity"])
+    r.fail(e, key, "give gravity either in loads.gravity or through environment, not both");
+  const double slope = e["slope_deg"] ? r.number(e["slope_deg"], key + ".slope_deg") : 0.0;
+  if (slope < -90 || slope > 90) r.fail(e["slope_deg"], key + ".slope_deg", "must be in [-90, 90]");
+  double heading = schedule ? schedule->orientation_deg : 0.0;
+  if (e["heading_deg"]) heading = r.number(e["heading_deg"], key + ".heading_deg");
+  const double g = e["gravity"] ? r.number(e["gravity"], key + ".gravity") : 9.80665;
+  if (!(g >= 0)) r.fail(e["gravity"], key + ".gravity", "must be >= 0 [m/s^2]");
+  const double deg = M_PI / 180.0, s_ = slope * deg, h = heading * deg;
+  // The voxel study's rotated gravity: uphill along the heading (cos h, sin h,
+  // 0).
+  scene.gravity = g * Eigen::Vector3d(-std::sin(s_) * std::cos(h), -std::sin(s_) * std::sin(h), -std::cos(s_));
+  scene.gait.heading = Eigen::Vector3d(std::cos(h), std::sin(h), 0.0);
+  if (e["body_length"]) {
+    scene.gait.body_length = r.number(e["body_length"], key + ".body_length");
+    if (!(scene.gait.body_length > 0)) r.fail(e["body_length"], key + ".body_length", "must be positive [m]");
+  }
+}
+
+}  // namespace morphfem
