@@ -205,16 +205,14 @@ int morphing(const Args& args, MPI_Comm comm) {
 
 // The subcommands, each run on this command's communicator.
 std::vector<Subcommand> subcommands(MPI_Comm comm) {
-  auto with = [comm](int (*run)(const Args&, MPI_Comm)) {
-    return [run, comm](const Args& args) { return run(args, comm); };
-  };
   return {
-      {"pull-tests", "friction coefficients of test-machine pull tests, statistics per group", with(pull_tests)},
-      {"synth-pull", "synthetic pull-test exports with known coefficients", with(synth_pull)},
-      {"drag", "a simulated pull test written as an export", with(drag)},
-      {"friction", "mu_static, mu_kinetic and stiffness fitted with the simulator", with(friction)},
-      {"materials", "hyperelastic fits to tensile exports, calibration file", with(materials)},
-      {"morphing", "the core valve's conductances from the morphing times", with(morphing)},
+      {"pull-tests", "friction coefficients of test-machine pull tests, statistics per group",
+       on_comm(pull_tests, comm)},
+      {"synth-pull", "synthetic pull-test exports with known coefficients", on_comm(synth_pull, comm)},
+      {"drag", "a simulated pull test written as an export", on_comm(drag, comm)},
+      {"friction", "mu_static, mu_kinetic and stiffness fitted with the simulator", on_comm(friction, comm)},
+      {"materials", "hyperelastic fits to tensile exports, calibration file", on_comm(materials, comm)},
+      {"morphing", "the core valve's conductances from the morphing times", on_comm(morphing, comm)},
   };
 }
 

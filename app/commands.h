@@ -4,6 +4,7 @@
 #pragma once
 #include <mpi.h>
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -15,5 +16,12 @@ int fit_materials_command(const std::vector<std::string>& args);
 int robot_command(const std::vector<std::string>& args, MPI_Comm comm);
 int search_command(const std::vector<std::string>& args, MPI_Comm comm);
 int calibrate_command(const std::vector<std::string>& args, MPI_Comm comm);
+
+// A subcommand's runner on `comm`, as core/command_line.h's Subcommand takes it.
+inline std::function<int(const std::vector<std::string>&)> on_comm(int (*run)(const std::vector<std::string>&,
+                                                                              MPI_Comm),
+                                                                   MPI_Comm comm) {
+  return [run, comm](const std::vector<std::string>& args) { return run(args, comm); };
+}
 
 }  // namespace morphfem

@@ -208,19 +208,16 @@ int levels(const Args& args, MPI_Comm) {
 
 // The subcommands, each run on this command's communicator.
 std::vector<Subcommand> subcommands(MPI_Comm comm) {
-  auto with = [comm](int (*run)(const Args&, MPI_Comm)) {
-    return [run, comm](const Args& args) { return run(args, comm); };
-  };
   return {
-      {"validate", "the voxel study's baselines on each preset", with(validate)},
-      {"ladder", "one case on several fidelity levels", with(ladder)},
-      {"spread", "one case under a perturbation ensemble", with(spread)},
-      {"morph", "shape change under core pressure", with(morph)},
-      {"friction-sweep", "inching against the feet's friction", with(friction_sweep)},
-      {"friction-drag", "the pull test on a robot scene", with(friction_drag)},
-      {"benchmark", "wall time of each gait against the voxel simulator", with(benchmark)},
-      {"scene", "the scene file of one case, for morphfem run", with(scene)},
-      {"levels", "the fidelity levels", with(levels)},
+      {"validate", "the voxel study's baselines on each preset", on_comm(validate, comm)},
+      {"ladder", "one case on several fidelity levels", on_comm(ladder, comm)},
+      {"spread", "one case under a perturbation ensemble", on_comm(spread, comm)},
+      {"morph", "shape change under core pressure", on_comm(morph, comm)},
+      {"friction-sweep", "inching against the feet's friction", on_comm(friction_sweep, comm)},
+      {"friction-drag", "the pull test on a robot scene", on_comm(friction_drag, comm)},
+      {"benchmark", "wall time of each gait against the voxel simulator", on_comm(benchmark, comm)},
+      {"scene", "the scene file of one case, for morphfem run", on_comm(scene, comm)},
+      {"levels", "the fidelity levels", on_comm(levels, comm)},
   };
 }
 
