@@ -14,6 +14,7 @@
 #include <optional>
 #include <sstream>
 
+#include "core/command_line.h"
 #include "core/errors.h"
 #include "core/json.h"
 #include "core/test_machine_export.h"
@@ -222,22 +223,23 @@ FitResult fit_yeoh(const std::vector<double>& stretch, const std::vector<double>
   return r;
 }
 
-FitResult fit_ogden(const std::vector<double>& stretch, const std::vector<double>& P, int terms) {
-  if (terms < 1 || terms > 4) throw std::invalid_argument("fit_ogden: 1 to 4 terms");
-  check_fit_data(stretch, P, 2 * static_cast<size_t>(terms));
-  const int n = static_cast<int>(stretch.size()), m = 2 * terms;
-  // Work with stresses scaled to O(1): theta = (mu_1/S .. mu_N/S, alpha_1 .. alpha_N).
-  double S = 0;
-  for (double p : P) S = std::max(S, std::abs(p));
-  if (S == 0.0) S = 1.0;
-  Eigen::VectorXd y(n), logl(n);
-  for (int i = 0; i < n; ++i) {
-    y(i) = P[i] / S;
-    logl(i) = std::log(stretch[i]);
-  }
-  auto residual = [&](const Eigen::VectorXd& th, Eigen::VectorXd& r, Eigen::MatrixXd* Jac) {
+namespace {
+
+// The Ogden least-squares problem in scaled form: stresses divided by S = max |P| so
+// the residuals are O(1); unknowns theta = (mu_1/S .. mu_N/S, alpha_1 .. alpha_N).
+struct OgdenProblem {
+  int terms = 0;
+  Eigen::VectorXd y;     // P_i / S [-]
+  Eigen::VectorXd logl;  // log lambda_i [-]
+
+  int points() const { return static_cast<int>(y.size()); }
+
+  // r_i = sum_p mu_p (lambda_i^(alpha_p - 1) - lambda_i^(-alpha_p/2 - 1)) - y_i, and
+  // its Jacobian dr/dmu_p = e1 - e2, dr/dalpha_p = mu_p log(lambda) (e1 + e2 / 2).
+  void residual(const Eigen::VectorXd& th, Eigen::VectorXd& r, Eigen::MatrixXd* Jac) const {
+    const int n = points();
     r = -y;
-    if (Jac) Jac->resize(n, m);
+    if (Jac) Jac->resize(n, 2 * terms);
     for (int p = 0; p < terms; ++p) {
       const double mu = th(p), a = th(terms + p);
       for (int i = 0; i < n; ++i) {
@@ -249,16 +251,22 @@ FitResult fit_ogden(const std::vector<double>& stretch, const std::vector<double
         }
       }
     }
-  };
+  }
+
   // Given exponents, the moduli are a linear least-squares problem (used for starts).
-  auto moduli_for = [&](const std::vector<double>& alpha) {
+  Eigen::VectorXd moduli_for(const std::vector<double>& alpha) const {
+    const int n = points();
     Eigen::MatrixXd B(n, terms);
     for (int p = 0; p < terms; ++p)
       for (int i = 0; i < n; ++i)
         B(i, p) = std::exp((alpha[p] - 1.0) * logl(i)) - std::exp((-0.5 * alpha[p] - 1.0) * logl(i));
     return linear_lsq(B, y);
-  };
-  auto levenberg_marquardt = [&](Eigen::VectorXd th, int max_iterations, bool& converged) {
+  }
+
+  // Levenberg-Marquardt on |r|^2 from `th`: returns (theta, cost); `converged` when the
+  // decrease or the step became negligible, or no damping gives a descent.
+  std::pair<Eigen::VectorXd, double> levenberg_marquardt(Eigen::VectorXd th, int max_iterations,
+                                                         bool& converged) const {
     Eigen::VectorXd r, r_new;
     Eigen::MatrixXd Jac;
     residual(th, r, &Jac);
@@ -290,10 +298,30 @@ FitResult fit_ogden(const std::vector<double>& stretch, const std::vector<double
       if (!accepted) converged = true;  // no descent possible: at a (local) minimum
     }
     return std::pair{th, cost};
-  };
+  }
+};
 
-  // Starts: every set of `terms` distinct exponents from a grid, moduli by linear LSQ,
-  // a few LM iterations each; the best starts are then iterated to convergence.
+// Scales the data (S = max |P|, 1 if all zero) into an OgdenProblem.
+OgdenProblem ogden_problem(const std::vector<double>& stretch, const std::vector<double>& P, int terms, double& S) {
+  S = 0;
+  for (double p : P) S = std::max(S, std::abs(p));
+  if (S == 0.0) S = 1.0;
+  const int n = static_cast<int>(stretch.size());
+  OgdenProblem problem;
+  problem.terms = terms;
+  problem.y.resize(n);
+  problem.logl.resize(n);
+  for (int i = 0; i < n; ++i) {
+    problem.y(i) = P[i] / S;
+    problem.logl(i) = std::log(stretch[i]);
+  }
+  return problem;
+}
+
+// Starts: every set of `terms` distinct exponents from a grid, moduli by linear LSQ,
+// a few LM iterations each. Returns the finite ones as (cost, theta), cheapest first.
+std::vector<std::pair<double, Eigen::VectorXd>> ogden_starts(const OgdenProblem& problem) {
+  const int terms = problem.terms;
   const std::vector<double> grid = {-4.0, -2.0, 1.0, 2.0, 3.0, 4.0, 6.0, 8.0};
   const int G = static_cast<int>(grid.size());
   std::vector<int> pick(terms);
@@ -302,11 +330,11 @@ FitResult fit_ogden(const std::vector<double>& stretch, const std::vector<double
   while (true) {
     std::vector<double> alpha(terms);
     for (int p = 0; p < terms; ++p) alpha[p] = grid[pick[p]];
-    Eigen::VectorXd th(m);
-    th.head(terms) = moduli_for(alpha);
+    Eigen::VectorXd th(2 * terms);
+    th.head(terms) = problem.moduli_for(alpha);
     for (int p = 0; p < terms; ++p) th(terms + p) = alpha[p];
     bool converged = false;
-    auto [th_fit, cost] = levenberg_marquardt(th, 30, converged);
+    auto [th_fit, cost] = problem.levenberg_marquardt(th, 30, converged);
     if (std::isfinite(cost) && th_fit.allFinite()) candidates.emplace_back(cost, th_fit);
     // next combination (lexicographic)
     int p = terms - 1;
@@ -315,30 +343,43 @@ FitResult fit_ogden(const std::vector<double>& stretch, const std::vector<double
     ++pick[p];
     for (int q = p + 1; q < terms; ++q) pick[q] = pick[q - 1] + 1;
   }
-  if (candidates.empty()) throw InputError("", "Ogden fit failed: no finite solution from any start");
   std::sort(candidates.begin(), candidates.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-  Eigen::VectorXd best;
-  double best_cost = std::numeric_limits<double>::infinity();
-  bool best_converged = false;
+  return candidates;
+}
+
+// The best of the three cheapest starts, each iterated to convergence.
+struct OgdenSolution {
+  Eigen::VectorXd theta;
+  double cost = std::numeric_limits<double>::infinity();
+  bool converged = false;
+};
+OgdenSolution refine_ogden_starts(const OgdenProblem& problem,
+                                  const std::vector<std::pair<double, Eigen::VectorXd>>& candidates) {
+  OgdenSolution best;
   for (size_t k = 0; k < std::min<size_t>(3, candidates.size()); ++k) {
     bool converged = false;
-    auto [th_fit, cost] = levenberg_marquardt(candidates[k].second, 1000, converged);
-    if (cost < best_cost && th_fit.allFinite()) {
-      best = th_fit;
-      best_cost = cost;
-      best_converged = converged;
+    auto [th_fit, cost] = problem.levenberg_marquardt(candidates[k].second, 1000, converged);
+    if (cost < best.cost && th_fit.allFinite()) {
+      best.theta = th_fit;
+      best.cost = cost;
+      best.converged = converged;
     }
   }
+  return best;
+}
 
+// The fit in physical units (mu_p = S theta_p), terms reported sorted by exponent,
+// with mu0 = sum mu_p alpha_p / 2 and stability mu_p alpha_p > 0.
+FitResult ogden_result(const OgdenSolution& best, double S, int terms, const std::vector<double>& stretch,
+                       const std::vector<double>& P) {
   FitResult r;
   r.model = "ogden";
-  r.converged = best_converged;
+  r.converged = best.converged;
   std::vector<double> mu(terms), alpha(terms);
   for (int p = 0; p < terms; ++p) {
-    mu[p] = best(p) * S;
-    alpha[p] = best(terms + p);
+    mu[p] = best.theta(p) * S;
+    alpha[p] = best.theta(terms + p);
   }
-  // Report terms sorted by exponent.
   std::vector<int> order(terms);
   for (int p = 0; p < terms; ++p) order[p] = p;
   std::sort(order.begin(), order.end(), [&](int a, int b) { return alpha[a] < alpha[b]; });
@@ -354,6 +395,18 @@ FitResult fit_ogden(const std::vector<double>& stretch, const std::vector<double
   r.rms = rms_error(stretch, P, [&](double l) { return uniaxial_stress_ogden(l, mu, alpha); });
   r.r2 = r_squared(P, r.rms);
   return r;
+}
+
+}  // namespace
+
+FitResult fit_ogden(const std::vector<double>& stretch, const std::vector<double>& P, int terms) {
+  if (terms < 1 || terms > 4) throw std::invalid_argument("fit_ogden: 1 to 4 terms");
+  check_fit_data(stretch, P, 2 * static_cast<size_t>(terms));
+  double S = 1;
+  const OgdenProblem problem = ogden_problem(stretch, P, terms, S);
+  const auto candidates = ogden_starts(problem);
+  if (candidates.empty()) throw InputError("", "Ogden fit failed: no finite solution from any start");
+  return ogden_result(refine_ogden_starts(problem, candidates), S, terms, stretch, P);
 }
 
 void select_strain_range(const TensileTest& test, double max_strain, std::vector<double>& stretch,
@@ -395,121 +448,140 @@ std::vector<MaterialFits> fit_material_directory(const std::string& data_dir, do
   return out;
 }
 
-int fit_materials_main(const std::vector<std::string>& args, const std::string& default_data_dir, std::ostream& out) {
-  const std::string usage =
-      "usage: morphfem fit-materials [--data-dir DIR] [--max-strain 2.0] [--json] [--curves FILE.csv]";
-  std::string data_dir = default_data_dir, curves_file;
-  double max_strain = 2.0;
-  bool json = false;
-  for (size_t i = 0; i < args.size(); ++i) {
-    const std::string& a = args[i];
-    auto value = [&]() -> const std::string& {
-      if (i + 1 >= args.size()) throw InputError("fit-materials", "option " + a + " needs a value; " + usage);
-      return args[++i];
-    };
-    if (a == "--data-dir") {
-      data_dir = value();
-    } else if (a == "--max-strain") {
-      const std::string& v = value();
-      const auto x = parse_number(v);
-      if (!x || *x <= 0.05 || *x > 20.0)
-        throw InputError("fit-materials", "--max-strain '" + v + "' must be an engineering strain in (0.05, 20]");
-      max_strain = *x;
-    } else if (a == "--json") {
-      json = true;
-    } else if (a == "--curves") {
-      curves_file = value();
-    } else if (a == "--help" || a == "-h") {
-      out << usage << "\n";
-      return 0;
-    } else {
-      throw InputError("fit-materials", "unknown argument '" + a + "'; " + usage);
-    }
+namespace {
+
+// `morphfem fit-materials` options; --help prints the usage and returns nullopt.
+std::optional<FitMaterialsOptions> parse_fit_materials_args(const std::vector<std::string>& args,
+                                                            const std::string& default_data_dir, std::ostream& out) {
+  CommandLine cl("morphfem fit-materials", "[--data-dir DIR] [--max-strain 2.0] [--json] [--curves FILE.csv]",
+                 "Fits neo-Hookean, Yeoh and Ogden (N = 1, 2, 3) laws to every *.csv tensile-test export in a "
+                 "directory and prints a table per material and model, or JSON.");
+  cl.value("--data-dir", "DIR", "the tensile-test exports (default: the shared materials data)")
+      .value("--max-strain", "STRAIN",
+             "fit the points with 0 < engineering strain <= STRAIN, in (0.05, 20] (default 2.0)")
+      .flag("--json", "print JSON instead of the table")
+      .value("--curves", "FILE.csv", "write data and fitted curves as CSV (for scripts/plot_material_fit.py)");
+  if (!cl.parse(args, out)) return std::nullopt;
+  FitMaterialsOptions o;
+  o.data_dir = cl.get("--data-dir", default_data_dir);
+  if (cl.has("--max-strain")) {
+    const std::string v = cl.get("--max-strain", "");
+    const auto x = parse_number(v);
+    if (!x || *x <= 0.05 || *x > 20.0)
+      throw InputError("fit-materials", "--max-strain '" + v + "' must be an engineering strain in (0.05, 20]");
+    o.max_strain = *x;
   }
-  if (data_dir.empty()) throw InputError("fit-materials", "no data directory: give --data-dir DIR");
+  o.json = cl.has("--json");
+  o.curves_file = cl.get("--curves", "");
+  return o;
+}
+
+// One material's fits as JSON: file, conversion, range and per model the coefficients,
+// RMS [Pa], R^2, small-strain mu [Pa], stability and convergence.
+Json material_fits_json(const MaterialFits& m) {
   namespace fs = std::filesystem;
+  std::vector<Json> json_fits;
+  for (const auto& f : m.fits) {
+    Json c;
+    for (size_t k = 0; k < f.names.size(); ++k) c.add(f.names[k], f.values[k]);
+    Json j;
+    j.add("model", f.model)
+        .add("coefficients", c)
+        .add("rms_pa", f.rms)
+        .add("r2", f.r2)
+        .add("small_strain_mu_pa", f.small_strain_mu)
+        .add("stable", f.stable)
+        .add("converged", f.converged);
+    json_fits.push_back(j);
+  }
+  Json material;
+  material.add("file", fs::path(m.test.file).filename().string())
+      .add("material", m.test.material)
+      .add("conversion", m.test.conversion)
+      .add("max_strain", m.max_strain)
+      .add("points", static_cast<int>(m.stretch.size()))
+      .add("stretch_range", std::vector<double>{m.stretch.front(), m.stretch.back()})
+      .add("fits", json_fits);
+  return material;
+}
+
+// One material's table: a heading (material, file, conversion, fitted range), then a
+// row per model with coefficients, RMS [kPa], R^2, mu0 [kPa] and stability.
+void print_material_fits(const MaterialFits& m, std::ostream& out) {
+  namespace fs = std::filesystem;
+  const TensileTest& test = m.test;
+  const std::vector<double>& stretch = m.stretch;
+  out << test.material << "  (" << fs::path(test.file).filename().string() << ")\n"
+      << "  " << test.conversion << "\n"
+      << "  fitted range: engineering strain <= " << m.max_strain << " -> stretch " << std::setprecision(4)
+      << stretch.front() << " .. " << stretch.back() << ", " << stretch.size() << " points\n";
+  out << "  " << std::left << std::setw(14) << "model" << std::setw(64) << "coefficients [Pa; alpha -]" << std::right
+      << std::setw(10) << "RMS [kPa]" << std::setw(9) << "R^2" << std::setw(12) << "mu0 [kPa]"
+      << "  stable\n";
+  for (const auto& f : m.fits) {
+    std::ostringstream c;
+    c << std::setprecision(5);
+    for (size_t k = 0; k < f.names.size(); ++k) c << (k ? ", " : "") << f.names[k] << " = " << f.values[k];
+    std::string label = f.model;
+    if (f.model == "ogden") label += " N=" + std::to_string(f.names.size() / 2);
+    out << "  " << std::left << std::setw(14) << label << std::setw(64) << c.str() << std::right << std::fixed
+        << std::setprecision(3) << std::setw(10) << f.rms / 1e3 << std::setprecision(5) << std::setw(9) << f.r2
+        << std::setw(12) << std::setprecision(2) << f.small_strain_mu / 1e3 << "  " << (f.stable ? "yes" : "NO")
+        << (f.converged ? "" : " (not converged)") << "\n"
+        << std::defaultfloat;
+  }
+  out << "\n";
+}
+
+// One CSV row per fitted point: material, stretch, data P and the fitted P [Pa] of
+// neo-Hookean, Yeoh and Ogden N = 1, 2, 3 (the order of MaterialFits::fits).
+void append_fit_curves(const MaterialFits& m, std::ostream& curves) {
+  const std::vector<FitResult>& fits = m.fits;
+  for (size_t i = 0; i < m.stretch.size(); ++i) {
+    const double l = m.stretch[i];
+    curves << '"' << m.test.material << '"' << ',' << l << ',' << m.stress[i] << ','
+           << uniaxial_stress_neo_hookean(l, fits[0].values[0]) << ','
+           << uniaxial_stress_yeoh(l, fits[1].values[0], fits[1].values[1], fits[1].values[2]);
+    for (int N = 1; N <= 3; ++N) {
+      const auto& f = fits[1 + N];
+      std::vector<double> mu, alpha;
+      for (size_t k = 0; k < f.values.size(); k += 2) {
+        mu.push_back(f.values[k]);
+        alpha.push_back(f.values[k + 1]);
+      }
+      curves << ',' << uniaxial_stress_ogden(l, mu, alpha);
+    }
+    curves << '\n';
+  }
+}
+
+}  // namespace
+
+int fit_materials(const FitMaterialsOptions& o, std::ostream& out) {
+  if (o.data_dir.empty()) throw InputError("fit-materials", "no data directory: give --data-dir DIR");
   std::vector<Json> json_materials;
   std::ostringstream curves;
   curves << "material,stretch,data_nominal_stress_pa,neo_hookean_pa,yeoh_pa,ogden1_pa,ogden2_pa,ogden3_pa\n";
   curves << std::setprecision(10);
-  for (const MaterialFits& m : fit_material_directory(data_dir, max_strain)) {
-    const TensileTest& test = m.test;
-    const std::string& file = test.file;
-    const std::vector<double>&stretch = m.stretch, &P = m.stress;
-    const std::vector<FitResult>& fits = m.fits;
-
-    if (json) {
-      std::vector<Json> json_fits;
-      for (const auto& f : fits) {
-        Json c;
-        for (size_t k = 0; k < f.names.size(); ++k) c.add(f.names[k], f.values[k]);
-        Json j;
-        j.add("model", f.model)
-            .add("coefficients", c)
-            .add("rms_pa", f.rms)
-            .add("r2", f.r2)
-            .add("small_strain_mu_pa", f.small_strain_mu)
-            .add("stable", f.stable)
-            .add("converged", f.converged);
-        json_fits.push_back(j);
-      }
-      Json m;
-      m.add("file", fs::path(file).filename().string())
-          .add("material", test.material)
-          .add("conversion", test.conversion)
-          .add("max_strain", max_strain)
-          .add("points", static_cast<int>(stretch.size()))
-          .add("stretch_range", std::vector<double>{stretch.front(), stretch.back()})
-          .add("fits", json_fits);
-      json_materials.push_back(m);
-    } else {
-      out << test.material << "  (" << fs::path(file).filename().string() << ")\n"
-          << "  " << test.conversion << "\n"
-          << "  fitted range: engineering strain <= " << max_strain << " -> stretch " << std::setprecision(4)
-          << stretch.front() << " .. " << stretch.back() << ", " << stretch.size() << " points\n";
-      out << "  " << std::left << std::setw(14) << "model" << std::setw(64) << "coefficients [Pa; alpha -]"
-          << std::right << std::setw(10) << "RMS [kPa]" << std::setw(9) << "R^2" << std::setw(12) << "mu0 [kPa]"
-          << "  stable\n";
-      for (const auto& f : fits) {
-        std::ostringstream c;
-        c << std::setprecision(5);
-        for (size_t k = 0; k < f.names.size(); ++k) c << (k ? ", " : "") << f.names[k] << " = " << f.values[k];
-        std::string label = f.model;
-        if (f.model == "ogden") label += " N=" + std::to_string(f.names.size() / 2);
-        out << "  " << std::left << std::setw(14) << label << std::setw(64) << c.str() << std::right << std::fixed
-            << std::setprecision(3) << std::setw(10) << f.rms / 1e3 << std::setprecision(5) << std::setw(9) << f.r2
-            << std::setw(12) << std::setprecision(2) << f.small_strain_mu / 1e3 << "  " << (f.stable ? "yes" : "NO")
-            << (f.converged ? "" : " (not converged)") << "\n"
-            << std::defaultfloat;
-      }
-      out << "\n";
-    }
-    if (!curves_file.empty()) {
-      for (size_t i = 0; i < stretch.size(); ++i) {
-        const double l = stretch[i];
-        curves << '"' << test.material << '"' << ',' << l << ',' << P[i] << ','
-               << uniaxial_stress_neo_hookean(l, fits[0].values[0]) << ','
-               << uniaxial_stress_yeoh(l, fits[1].values[0], fits[1].values[1], fits[1].values[2]);
-        for (int N = 1; N <= 3; ++N) {
-          const auto& f = fits[1 + N];
-          std::vector<double> mu, alpha;
-          for (size_t k = 0; k < f.values.size(); k += 2) {
-            mu.push_back(f.values[k]);
-            alpha.push_back(f.values[k + 1]);
-          }
-          curves << ',' << uniaxial_stress_ogden(l, mu, alpha);
-        }
-        curves << '\n';
-      }
-    }
+  for (const MaterialFits& m : fit_material_directory(o.data_dir, o.max_strain)) {
+    if (o.json)
+      json_materials.push_back(material_fits_json(m));
+    else
+      print_material_fits(m, out);
+    if (!o.curves_file.empty()) append_fit_curves(m, curves);
   }
-  if (json) {
+  if (o.json) {
     Json root;
-    root.add("max_strain", max_strain).add("materials", json_materials);
+    root.add("max_strain", o.max_strain).add("materials", json_materials);
     out << root.str(true) << "\n";
   }
-  if (!curves_file.empty()) write_file_atomic(curves_file, curves.str());
+  if (!o.curves_file.empty()) write_file_atomic(o.curves_file, curves.str());
   return 0;
+}
+
+int fit_materials_main(const std::vector<std::string>& args, const std::string& default_data_dir, std::ostream& out) {
+  const std::optional<FitMaterialsOptions> options = parse_fit_materials_args(args, default_data_dir, out);
+  return options ? fit_materials(*options, out) : 0;
 }
 
 }  // namespace morphfem
