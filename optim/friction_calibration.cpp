@@ -112,13 +112,13 @@ int write_simulated_pull(const SimulatedPullOptions& o, MPI_Comm comm) {
   return 0;
 }
 
-int calibrate_friction(const FrictionCalibrationOptions& o, MPI_Comm comm) {
-  const double weight = o.weight_N;
-  const std::string &surface = o.surface, &foot = o.foot, &dir = o.out_dir;
-  const std::vector<std::string>& inputs = o.inputs;
-  const FrictionFitOptions& options = o.fit;
-  if (weight <= 0) throw InputError("calibrate friction", "--weight-N W (the robot's weight [N]) is required");
-  if (inputs.empty()) throw InputError("calibrate friction", "no export files or folders given");
+namespace {
+
+// The pull tests of the exports in one (surface, foot state) group: those matching
+// `surface` and `foot` (empty: any); InputError if none match or several groups remain.
+// `group` is "surface/foot_state".
+std::vector<PullCurve> read_pull_group(const std::vector<std::string>& inputs, const std::string& surface,
+                                       const std::string& foot, std::string& group) {
   std::vector<PullCurve> curves;
   std::set<std::string> groups;
   for (const auto& s : read_test_machine_exports(inputs)) {
@@ -134,61 +134,89 @@ int calibrate_friction(const FrictionCalibrationOptions& o, MPI_Comm comm) {
     throw InputError("calibrate friction", "the curves belong to several groups (" + list +
                                                " ): fit one at a time with --surface and --foot");
   }
-  const FrictionFitResult r = fit_friction(curves, weight, options, comm);
+  group = *groups.begin();
+  return curves;
+}
+
+// The fitted coefficients with standard errors, 95 % intervals and starts.
+void print_friction_fit(const std::string& group, const std::vector<PullCurve>& curves, double travel_m,
+                        const FrictionFitResult& r) {
   const LeastSquaresFit& f = r.fit;
+  std::cout << "friction fit: " << group << ", " << curves.size() << " curve(s), travel <= " << travel_m * 1e3
+            << " mm, " << f.residuals.size() << " residuals, " << f.evaluations << " simulations, TAO POUNDERS "
+            << f.reason << "\n";
+  for (size_t j = 0; j < f.names.size(); ++j)
+    std::cout << "  " << std::left << std::setw(18) << f.names[j] << std::right << std::setprecision(6) << std::setw(12)
+              << f.values[j] << "  +/- " << std::setw(10) << f.std_error[j] << "  95% CI [" << f.ci_low[j] << ", "
+              << f.ci_high[j] << "]  (start " << r.start[j] << ")\n";
+  std::cout << "  residual RMS " << f.rms << " N\n";
+}
+
+// friction_SURFACE_FOOT.yaml, the calibration file scenes load.
+void write_friction_calibration(const FrictionCalibrationOptions& o, const std::vector<PullCurve>& curves,
+                                const FrictionFitResult& r) {
+  const LeastSquaresFit& f = r.fit;
+  Calibration cal;
+  cal.kind = "friction";
+  cal.command = "morphfem calibrate friction";
+  cal.command += o.command_arguments;
+  cal.created = now_utc();
+  cal.group = {{"surface", curves.front().surface}, {"foot_state", curves.front().foot_state}};
+  const std::vector<std::string> units = {"-", "-", "N/m"};
+  for (size_t j = 0; j < f.names.size(); ++j)
+    cal.parameters.emplace_back(f.names[j],
+                                CalibratedValue{f.values[j], f.std_error[j], f.ci_low[j], f.ci_high[j], units[j]});
+  cal.fit = {{"method", "PETSc TAO POUNDERS on the simulated drag test (sim/drag_scene.h)"},
+             {"residual_rms_N", json_number(f.rms)},
+             {"residuals", std::to_string(f.residuals.size())},
+             {"evaluations", std::to_string(f.evaluations)},
+             {"converged", f.converged ? "true" : "false"},
+             {"reason", f.reason},
+             {"travel_m", json_number(o.fit.travel)},
+             {"weight_N", json_number(o.weight_N)}};
+  for (const auto& c : curves) cal.data.push_back({c.file, sha256_file(c.file), c.label});
+  const std::string yaml = (std::filesystem::path(o.out_dir) /
+                            ("friction_" + cal.group["surface"] + "_" + cal.group["foot_state"] + ".yaml"))
+                               .string();
+  write_calibration_file(yaml, cal);
+  std::cout << "calibration: " << yaml << "\n";
+}
+
+// Overlay table friction_overlay.csv (every data sample within the travel [mm, N] and
+// the simulated curve) and its plot.
+void write_friction_overlay(const std::string& dir, const std::vector<PullCurve>& curves, double travel_m,
+                            const FrictionFitResult& r) {
+  std::ostringstream csv;
+  csv << std::setprecision(8) << "curve,displacement_mm,force_N\n";
+  for (const auto& c : curves)
+    for (size_t i = 0; i < c.displacement.size(); ++i)
+      if (c.displacement[i] <= travel_m)
+        csv << '"' << c.label << "\"," << c.displacement[i] * 1e3 << ',' << c.force[i] << '\n';
+  for (size_t i = 0; i < r.best.displacement.size(); ++i)
+    csv << "simulated," << r.best.displacement[i] * 1e3 << ',' << r.best.force[i] << '\n';
+  const std::string overlay = (std::filesystem::path(dir) / "friction_overlay.csv").string();
+  write_file_atomic(overlay, csv.str());
+  const std::string png = (std::filesystem::path(dir) / "friction_overlay.png").string();
+  if (run_plot_script("plot_calibration.py", {"friction", overlay, png}, "the calibration"))
+    std::cout << "plot: " << png << "\n";
+}
+
+}  // namespace
+
+int calibrate_friction(const FrictionCalibrationOptions& o, MPI_Comm comm) {
+  if (o.weight_N <= 0) throw InputError("calibrate friction", "--weight-N W (the robot's weight [N]) is required");
+  if (o.inputs.empty()) throw InputError("calibrate friction", "no export files or folders given");
+  std::string group;
+  const std::vector<PullCurve> curves = read_pull_group(o.inputs, o.surface, o.foot, group);
+  const FrictionFitResult r = fit_friction(curves, o.weight_N, o.fit, comm);
   int rank = 0;
   MPI_Comm_rank(comm, &rank);
-  const bool root = rank == 0;
-  if (root) {
-    std::cout << "friction fit: " << *groups.begin() << ", " << curves.size()
-              << " curve(s), travel <= " << options.travel * 1e3 << " mm, " << f.residuals.size() << " residuals, "
-              << f.evaluations << " simulations, TAO POUNDERS " << f.reason << "\n";
-    for (size_t j = 0; j < f.names.size(); ++j)
-      std::cout << "  " << std::left << std::setw(18) << f.names[j] << std::right << std::setprecision(6)
-                << std::setw(12) << f.values[j] << "  +/- " << std::setw(10) << f.std_error[j] << "  95% CI ["
-                << f.ci_low[j] << ", " << f.ci_high[j] << "]  (start " << r.start[j] << ")\n";
-    std::cout << "  residual RMS " << f.rms << " N\n";
-  }
-  if (!dir.empty() && root) {
-    std::filesystem::create_directories(dir);
-    Calibration cal;
-    cal.kind = "friction";
-    cal.command = "morphfem calibrate friction";
-    cal.command += o.command_arguments;
-    cal.created = now_utc();
-    cal.group = {{"surface", curves.front().surface}, {"foot_state", curves.front().foot_state}};
-    const std::vector<std::string> units = {"-", "-", "N/m"};
-    for (size_t j = 0; j < f.names.size(); ++j)
-      cal.parameters.emplace_back(f.names[j],
-                                  CalibratedValue{f.values[j], f.std_error[j], f.ci_low[j], f.ci_high[j], units[j]});
-    cal.fit = {{"method", "PETSc TAO POUNDERS on the simulated drag test (sim/drag_scene.h)"},
-               {"residual_rms_N", json_number(f.rms)},
-               {"residuals", std::to_string(f.residuals.size())},
-               {"evaluations", std::to_string(f.evaluations)},
-               {"converged", f.converged ? "true" : "false"},
-               {"reason", f.reason},
-               {"travel_m", json_number(options.travel)},
-               {"weight_N", json_number(weight)}};
-    for (const auto& c : curves) cal.data.push_back({c.file, sha256_file(c.file), c.label});
-    const std::string yaml =
-        (std::filesystem::path(dir) / ("friction_" + cal.group["surface"] + "_" + cal.group["foot_state"] + ".yaml"))
-            .string();
-    write_calibration_file(yaml, cal);
-    std::cout << "calibration: " << yaml << "\n";
-    // Overlay table: every data sample within the travel and the simulated curve.
-    std::ostringstream csv;
-    csv << std::setprecision(8) << "curve,displacement_mm,force_N\n";
-    for (const auto& c : curves)
-      for (size_t i = 0; i < c.displacement.size(); ++i)
-        if (c.displacement[i] <= options.travel)
-          csv << '"' << c.label << "\"," << c.displacement[i] * 1e3 << ',' << c.force[i] << '\n';
-    for (size_t i = 0; i < r.best.displacement.size(); ++i)
-      csv << "simulated," << r.best.displacement[i] * 1e3 << ',' << r.best.force[i] << '\n';
-    const std::string overlay = (std::filesystem::path(dir) / "friction_overlay.csv").string();
-    write_file_atomic(overlay, csv.str());
-    const std::string png = (std::filesystem::path(dir) / "friction_overlay.png").string();
-    if (run_plot_script("plot_calibration.py", {"friction", overlay, png}, "the calibration"))
-      std::cout << "plot: " << png << "\n";
+  if (rank != 0) return 0;
+  print_friction_fit(group, curves, o.fit.travel, r);
+  if (!o.out_dir.empty()) {
+    std::filesystem::create_directories(o.out_dir);
+    write_friction_calibration(o, curves, r);
+    write_friction_overlay(o.out_dir, curves, o.fit.travel, r);
   }
   return 0;
 }

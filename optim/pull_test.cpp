@@ -99,78 +99,72 @@ PullCurve pull_curve_from_export(const SpecimenExport& s) {
   return c;
 }
 
-PullAnalysis analyse_pull(const PullCurve& curve, double weight_N) {
-  if (!(weight_N > 0.0)) throw std::invalid_argument("analyse_pull: weight must be > 0");
-  const auto& x = curve.displacement;
-  const auto& F = curve.force;
-  const size_t n = F.size();
-  if (n < 20 || x.size() != n) throw InputError(curve.file, "pull test: fewer than 20 points");
-  PullAnalysis a;
-  // 1. Noise from second differences.
+namespace {
+
+// Noise sigma [N] from second differences: for white noise of sigma s,
+// F[i+1] - 2 F[i] + F[i-1] has sigma s sqrt(6), and its MAD is 1.4826 times sigma.
+double force_noise(const std::vector<double>& F) {
   std::vector<double> d2;
-  for (size_t i = 1; i + 1 < n; ++i) d2.push_back(std::abs(F[i + 1] - 2.0 * F[i] + F[i - 1]));
-  a.noise_N = 1.4826 * median_of(d2) / std::sqrt(6.0);
-  // 2. Static peak: maximum of the smoothed force before its first drop.
-  const std::vector<double> Fs = smooth(F);
+  for (size_t i = 1; i + 1 < F.size(); ++i) d2.push_back(std::abs(F[i + 1] - 2.0 * F[i] + F[i - 1]));
+  return 1.4826 * median_of(d2) / std::sqrt(6.0);
+}
+
+// Static peak: the index of the running maximum of the smoothed force `Fs` when the
+// force first drops (by 4 sigma or 3 %) after exceeding 20 % of its global maximum;
+// the global maximum if it never drops.
+size_t smoothed_peak_index(const std::vector<double>& Fs, double noise_N) {
   const double global_max = *std::max_element(Fs.begin(), Fs.end());
-  if (!(global_max > 0.0)) throw InputError(curve.file, "pull test: the force never rises above zero");
   size_t p = static_cast<size_t>(std::max_element(Fs.begin(), Fs.end()) - Fs.begin());
-  {
-    double running = -std::numeric_limits<double>::infinity();
-    size_t arg = 0;
-    for (size_t i = 0; i < n; ++i) {
-      if (Fs[i] > running) {
-        running = Fs[i];
-        arg = i;
-      }
-      if (running > 0.2 * global_max && Fs[i] < running - std::max(4.0 * a.noise_N, 0.03 * running)) {
-        p = arg;
-        break;
-      }
+  double running = -std::numeric_limits<double>::infinity();
+  size_t arg = 0;
+  for (size_t i = 0; i < Fs.size(); ++i) {
+    if (Fs[i] > running) {
+      running = Fs[i];
+      arg = i;
+    }
+    if (running > 0.2 * global_max && Fs[i] < running - std::max(4.0 * noise_N, 0.03 * running)) {
+      p = arg;
+      break;
     }
   }
-  // Peak force: the largest 3-point mean of the raw force within 3 samples of p (the
-  // 5+5-point smoothing would blunt the slip cusp).
-  // The window of the linear fit ends at that 3-point peak, so it holds no point of
-  // the drop (the smoothed maximum can sit a sample or two past the cusp).
-  a.peak_force_N = -std::numeric_limits<double>::infinity();
-  {
-    size_t top = p;
-    for (size_t i = (p > 4 ? p - 3 : 1); i <= std::min(p + 3, n - 2); ++i) {
-      const double f3 = (F[i - 1] + F[i] + F[i + 1]) / 3.0;
-      if (f3 > a.peak_force_N) {
-        a.peak_force_N = f3;
-        top = i;
-      }
+  return p;
+}
+
+// Peak force: the largest 3-point mean of the raw force within 3 samples of p (the
+// 5+5-point smoothing would blunt the slip cusp). Returns its index, the force in
+// `peak_force_N`. The window of the linear fit ends there, so it holds no point of
+// the drop (the smoothed maximum can sit a sample or two past the cusp).
+size_t raw_peak_index(const std::vector<double>& F, size_t p, double& peak_force_N) {
+  const size_t n = F.size();
+  peak_force_N = -std::numeric_limits<double>::infinity();
+  size_t top = p;
+  for (size_t i = (p > 4 ? p - 3 : 1); i <= std::min(p + 3, n - 2); ++i) {
+    const double f3 = (F[i - 1] + F[i] + F[i + 1]) / 3.0;
+    if (f3 > peak_force_N) {
+      peak_force_N = f3;
+      top = i;
     }
-    p = top;
   }
-  a.peak_m = x[p];
-  // 3. Window: first point above 5 % of the peak .. p.
-  size_t s = 0;
-  while (s < p && Fs[s] < 0.05 * a.peak_force_N) ++s;
-  if (p < s + 6) throw InputError(curve.file, "pull test: fewer than 6 points between the slack and the peak");
-  a.linear_start_m = x[s];
-  // 4. Hinge fit. Coordinates scaled to the window (conditioning).
-  const double xs = x[s], L = std::max(x[p] - x[s], 1e-12);
-  const int m = static_cast<int>(p - s + 1);
-  Eigen::VectorXd xi(m), y(m);
-  for (int i = 0; i < m; ++i) {
-    xi(i) = (x[s + i] - xs) / L;
-    y(i) = F[s + i];
-  }
-  Eigen::MatrixXd B(m, 2);
-  B.col(0).setOnes();
-  B.col(1) = xi;
-  const Eigen::Vector2d line = B.colPivHouseholderQr().solve(y);
-  const double sse_line = (B * line - y).squaredNorm();
-  double best_sse = sse_line, best_b = 1.0, best_a = line(0), best_k = line(1);
+  return top;
+}
+
+// F ~ a + k xi (+ knee) on the window scaled to xi in [0, 1]; b is where the linear
+// regime ends (1 without a knee).
+struct HingeFit {
+  double sse = 0, b = 1.0, a = 0, k = 0;
   bool knee = false;
+};
+
+// The best hinge F = a + k xi - c g(xi - b), c > 0, over knee positions b (the window's
+// points, ends excluded) and knee shapes g(d) = l^2 (d/l - 1 + exp(-d/l)) for l from
+// 1 % of the window to 3 windows (the largest is the parabola d^2/2 to within a few
+// %); `line` when no hinge fits better.
+HingeFit best_hinge(const Eigen::VectorXd& xi, const Eigen::VectorXd& y, const HingeFit& line) {
+  const int m = static_cast<int>(xi.size());
+  HingeFit best = line;
   Eigen::MatrixXd H(m, 3);
   H.col(0).setOnes();
   H.col(1) = xi;
-  // Knee shapes g(d) = l^2 (d/l - 1 + exp(-d/l)) for l from 1 % of the window to
-  // 3 windows (the largest is the parabola d^2/2 to within a few %).
   for (int j = 3; j < m - 2; ++j) {
     const double b = xi(j);
     for (double ell = 0.01; ell < 3.0; ell *= 1.5) {
@@ -181,41 +175,80 @@ PullAnalysis analyse_pull(const PullCurve& curve, double weight_N) {
       const Eigen::Vector3d c = H.colPivHouseholderQr().solve(y);
       if (!(c(2) > 0.0)) continue;
       const double sse = (H * c - y).squaredNorm();
-      if (sse < best_sse) {
-        best_sse = sse;
-        best_b = b;
-        best_a = c(0);
-        best_k = c(1);
-        knee = true;
-      }
+      if (sse < best.sse) best = {sse, b, c(0), c(1), true};
     }
   }
+  return best;
+}
+
+// The linear regime over the window s .. p: a line, or a line with a knee where the
+// knee improves the fit significantly. Fills linear_end_m, linear_end_force_N,
+// slope_N_per_m and knee_found of `a` (whose noise and peak are known).
+void fit_linear_regime(const std::vector<double>& x, const std::vector<double>& F, size_t s, size_t p,
+                       PullAnalysis& a) {
+  // Coordinates scaled to the window (conditioning).
+  const double xs = x[s], L = std::max(x[p] - x[s], 1e-12);
+  const int m = static_cast<int>(p - s + 1);
+  Eigen::VectorXd xi(m), y(m);
+  for (int i = 0; i < m; ++i) {
+    xi(i) = (x[s + i] - xs) / L;
+    y(i) = F[s + i];
+  }
+  Eigen::MatrixXd B(m, 2);
+  B.col(0).setOnes();
+  B.col(1) = xi;
+  const Eigen::Vector2d coefficients = B.colPivHouseholderQr().solve(y);
+  const HingeFit line{(B * coefficients - y).squaredNorm(), 1.0, coefficients(0), coefficients(1), false};
+  HingeFit best = best_hinge(xi, y, line);
   // A knee must improve the fit by more than the noise, and by more than a load cell
   // resolves (0.1 % of the peak force): a noise-free (simulated) curve would otherwise
   // take the slight, gradual creep of its regularised friction for a knee.
   const double resolution = std::max(a.noise_N, 1e-3 * a.peak_force_N);
-  if (knee && sse_line - best_sse < 25.0 * resolution * resolution) {
-    knee = false;
-    best_b = 1.0;
-    best_a = line(0);
-    best_k = line(1);
-  }
-  a.knee_found = knee;
-  a.linear_end_m = xs + best_b * L;
+  if (best.knee && line.sse - best.sse < 25.0 * resolution * resolution) best = line;
+  a.knee_found = best.knee;
+  a.linear_end_m = xs + best.b * L;
   // Without a knee the line runs to the peak; the fitted line there can overshoot the
   // rounded top, so it is capped by the smoothed peak force.
-  a.linear_end_force_N = knee ? best_a + best_k * best_b : std::min(best_a + best_k * best_b, a.peak_force_N);
-  a.slope_N_per_m = best_k / L;
-  // Kinetic: mean over the last 75 % of the travel after the peak.
+  a.linear_end_force_N = best.knee ? best.a + best.k * best.b : std::min(best.a + best.k * best.b, a.peak_force_N);
+  a.slope_N_per_m = best.k / L;
+}
+
+// Kinetic force [N]: mean over the last 75 % of the travel after the peak p; sets
+// kinetic_from_m and kinetic_force_N of `a`.
+void kinetic_force(const std::vector<double>& x, const std::vector<double>& F, size_t p, PullAnalysis& a) {
   a.kinetic_from_m = x[p] + 0.25 * (x.back() - x[p]);
   double sum = 0;
   int count = 0;
-  for (size_t i = p; i < n; ++i)
+  for (size_t i = p; i < F.size(); ++i)
     if (x[i] >= a.kinetic_from_m) {
       sum += F[i];
       ++count;
     }
   a.kinetic_force_N = count > 0 ? sum / count : 0.0;
+}
+
+}  // namespace
+
+PullAnalysis analyse_pull(const PullCurve& curve, double weight_N) {
+  if (!(weight_N > 0.0)) throw std::invalid_argument("analyse_pull: weight must be > 0");
+  const auto& x = curve.displacement;
+  const auto& F = curve.force;
+  const size_t n = F.size();
+  if (n < 20 || x.size() != n) throw InputError(curve.file, "pull test: fewer than 20 points");
+  PullAnalysis a;
+  a.noise_N = force_noise(F);
+  const std::vector<double> Fs = smooth(F);
+  if (!(*std::max_element(Fs.begin(), Fs.end()) > 0.0))
+    throw InputError(curve.file, "pull test: the force never rises above zero");
+  const size_t p = raw_peak_index(F, smoothed_peak_index(Fs, a.noise_N), a.peak_force_N);
+  a.peak_m = x[p];
+  // Window: first point above 5 % of the peak .. p.
+  size_t s = 0;
+  while (s < p && Fs[s] < 0.05 * a.peak_force_N) ++s;
+  if (p < s + 6) throw InputError(curve.file, "pull test: fewer than 6 points between the slack and the peak");
+  a.linear_start_m = x[s];
+  fit_linear_regime(x, F, s, p, a);
+  kinetic_force(x, F, p, a);
   a.mu_linear = a.linear_end_force_N / weight_N;
   a.mu_peak = a.peak_force_N / weight_N;
   a.mu_kinetic = a.kinetic_force_N / weight_N;
@@ -335,24 +368,27 @@ int write_synthetic_pulls(const SyntheticPullSet& set, std::ostream& out) {
   return 0;
 }
 
-int analyse_pull_tests(const PullTestsOptions& o, std::ostream& out) {
-  const double weight = o.weight_N;
-  const std::string& dir = o.out_dir;
-  const std::vector<std::string>& inputs = o.inputs;
-  const std::string& plot_script = o.plot_script;
-  if (weight <= 0) throw InputError("calibrate pull-tests", "--weight-N W (the robot's weight [N]) is required");
-  if (inputs.empty()) throw InputError("calibrate pull-tests", "no export files or folders given");
-  const auto specimens = read_test_machine_exports(inputs);
-  struct Row {
-    PullCurve curve;
-    PullAnalysis analysis;
-  };
-  std::vector<Row> rows;
-  for (const auto& s : specimens) {
+namespace {
+
+struct PullRow {
+  PullCurve curve;
+  PullAnalysis analysis;
+};
+
+// Every specimen of the exports (files or folders) read and analysed.
+std::vector<PullRow> analyse_exports(const std::vector<std::string>& inputs, double weight_N) {
+  std::vector<PullRow> rows;
+  for (const auto& s : read_test_machine_exports(inputs)) {
     PullCurve c = pull_curve_from_export(s);
-    PullAnalysis a = analyse_pull(c, weight);
+    PullAnalysis a = analyse_pull(c, weight_N);
     rows.push_back({std::move(c), a});
   }
+  return rows;
+}
+
+// The per-test table on `out`; returns the same rows as pull_tests.csv (lengths in mm,
+// slope in N/mm).
+std::string print_pull_rows(const std::vector<PullRow>& rows, std::ostream& out) {
   std::ostringstream csv;
   csv << std::setprecision(8)
       << "file,label,surface,foot_state,mu_linear,mu_peak,mu_kinetic,linear_end_mm,linear_end_force_N,slope_N_per_mm,"
@@ -372,8 +408,13 @@ int analyse_pull_tests(const PullTestsOptions& o, std::ostream& out) {
         << a.linear_end_force_N << ',' << a.slope_N_per_m * 1e-3 << ',' << a.peak_m * 1e3 << ',' << a.peak_force_N
         << ',' << a.kinetic_force_N << ',' << a.noise_N << ',' << (a.knee_found ? 1 : 0) << '\n';
   }
-  // Groups by (surface, foot state).
-  std::map<std::pair<std::string, std::string>, std::vector<const Row*>> groups;
+  return csv.str();
+}
+
+// Statistics of mu_linear, mu_peak and mu_kinetic per (surface, foot state): a table
+// on `out`, and one JSON object per group.
+std::vector<Json> summarise_pull_groups(const std::vector<PullRow>& rows, std::ostream& out) {
+  std::map<std::pair<std::string, std::string>, std::vector<const PullRow*>> groups;
   for (const auto& r : rows) groups[{r.curve.surface, r.curve.foot_state}].push_back(&r);
   std::vector<Json> json_groups;
   out << "\n"
@@ -386,7 +427,7 @@ int analyse_pull_tests(const PullTestsOptions& o, std::ostream& out) {
     g.add("surface", key.first).add("foot_state", key.second).add("tests", static_cast<int>(members.size()));
     for (const char* name : {"mu_linear", "mu_peak", "mu_kinetic"}) {
       std::vector<double> v;
-      for (const Row* r : members)
+      for (const PullRow* r : members)
         v.push_back(std::string(name) == "mu_linear" ? r->analysis.mu_linear
                     : std::string(name) == "mu_peak" ? r->analysis.mu_peak
                                                      : r->analysis.mu_kinetic);
@@ -402,21 +443,39 @@ int analyse_pull_tests(const PullTestsOptions& o, std::ostream& out) {
     }
     json_groups.push_back(g);
   }
-  if (!dir.empty()) {
-    std::filesystem::create_directories(dir);
-    const std::string csv_path = (std::filesystem::path(dir) / "pull_tests.csv").string();
-    write_file_atomic(csv_path, csv.str());
-    Json root;
-    root.add("command", "morphfem calibrate pull-tests" + o.command_arguments)
-        .add("weight_N", weight)
-        .add("groups", json_groups);
-    write_file_atomic((std::filesystem::path(dir) / "pull_summary.json").string(), root.str(true) + "\n");
-    if (!plot_script.empty() && std::filesystem::exists("/usr/bin/python3") && std::filesystem::exists(plot_script)) {
-      const std::string png = (std::filesystem::path(dir) / "pull_boxplot.png").string();
-      const std::string command = "/usr/bin/python3 '" + plot_script + "' pull '" + csv_path + "' '" + png + "' >&2";
-      if (std::system(command.c_str()) == 0) out << "box plot: " << png << "\n";
-    }
+  return json_groups;
+}
+
+// pull_tests.csv, pull_summary.json and (with python3 and the script) a box plot in
+// o.out_dir.
+void write_pull_outputs(const PullTestsOptions& o, const std::string& csv, const std::vector<Json>& json_groups,
+                        std::ostream& out) {
+  const std::string& dir = o.out_dir;
+  const std::string& plot_script = o.plot_script;
+  std::filesystem::create_directories(dir);
+  const std::string csv_path = (std::filesystem::path(dir) / "pull_tests.csv").string();
+  write_file_atomic(csv_path, csv);
+  Json root;
+  root.add("command", "morphfem calibrate pull-tests" + o.command_arguments)
+      .add("weight_N", o.weight_N)
+      .add("groups", json_groups);
+  write_file_atomic((std::filesystem::path(dir) / "pull_summary.json").string(), root.str(true) + "\n");
+  if (!plot_script.empty() && std::filesystem::exists("/usr/bin/python3") && std::filesystem::exists(plot_script)) {
+    const std::string png = (std::filesystem::path(dir) / "pull_boxplot.png").string();
+    const std::string command = "/usr/bin/python3 '" + plot_script + "' pull '" + csv_path + "' '" + png + "' >&2";
+    if (std::system(command.c_str()) == 0) out << "box plot: " << png << "\n";
   }
+}
+
+}  // namespace
+
+int analyse_pull_tests(const PullTestsOptions& o, std::ostream& out) {
+  if (o.weight_N <= 0) throw InputError("calibrate pull-tests", "--weight-N W (the robot's weight [N]) is required");
+  if (o.inputs.empty()) throw InputError("calibrate pull-tests", "no export files or folders given");
+  const std::vector<PullRow> rows = analyse_exports(o.inputs, o.weight_N);
+  const std::string csv = print_pull_rows(rows, out);
+  const std::vector<Json> json_groups = summarise_pull_groups(rows, out);
+  if (!o.out_dir.empty()) write_pull_outputs(o, csv, json_groups, out);
   return 0;
 }
 
