@@ -311,113 +311,166 @@ bool SpecimenExport::header_si(const std::string& key_part, double& value) const
   return false;
 }
 
+namespace {
+
+// An export's lines split at its separator, with "FILE:LINE" locations for errors.
+struct ExportText {
+  const std::vector<std::string>& lines;
+  char sep;
+  const std::string& file;
+
+  std::vector<Field> fields(size_t i) const { return split(lines[i], sep); }
+  std::string at(size_t i) const { return file + ":" + std::to_string(i + 1); }
+};
+
+// Where one specimen block's parts are: header lines from `start`, the column names
+// row, an optional units row under it, and the first data row.
+struct BlockLayout {
+  size_t start = 0, names_line = 0, data_start = 0;
+  std::optional<size_t> units_line;
+};
+
+// The layout of the block starting at line `start`: everything up to the first numeric
+// row is header, names and units; the last non-empty row before the data holds the
+// names, unless every cell of it is a unit, which makes it the units row under names.
+BlockLayout locate_block(const ExportText& t, size_t start) {
+  BlockLayout b;
+  b.start = start;
+  b.data_start = start;
+  while (b.data_start < t.lines.size() && !numeric_row(t.fields(b.data_start), t.sep)) ++b.data_start;
+  if (b.data_start == t.lines.size())
+    throw InputError(t.at(start), "specimen block without data rows (no line of numbers after it)");
+  std::vector<size_t> non_empty;
+  for (size_t k = start; k < b.data_start; ++k)
+    if (!all_empty(t.fields(k))) non_empty.push_back(k);
+  if (non_empty.empty()) throw InputError(t.at(b.data_start), "no column names row before the data");
+  b.names_line = non_empty.back();
+  const auto f = t.fields(b.names_line);
+  const size_t n = used_fields(f);
+  bool units = n > 0;
+  for (size_t c = 0; c < n; ++c)
+    if (!f[c].text.empty() && !is_unit_cell(f[c].text)) units = false;
+  if (units) {
+    if (non_empty.size() < 2) throw InputError(t.at(b.names_line), "a units row without a column names row above it");
+    b.units_line = b.names_line;
+    b.names_line = non_empty[non_empty.size() - 2];
+  }
+  return b;
+}
+
+// One column from its name cell and its units-row cell (empty without a units row):
+// the unit gives the quantity and the factor to SI; only a strain may have no unit.
+ExportColumn read_column(const ExportText& t, const BlockLayout& b, const Field& name, const std::string& unit_cell,
+                         size_t c) {
+  ExportColumn col;
+  col.label = name.text;
+  if (col.label.empty()) throw InputError(t.at(b.names_line), "column " + std::to_string(c + 1) + " has no name");
+  name_and_unit(col.label, col.name, col.unit);
+  if (b.units_line && !unit_cell.empty()) {
+    col.unit = strip_brackets(unit_cell);
+    col.label += " (" + col.unit + ")";
+  }
+  const bool strain_name = lower(col.name).find("strain") != std::string::npos;
+  if (col.unit.empty()) {
+    if (!strain_name)
+      throw InputError(t.at(b.names_line), "column '" + col.name +
+                                               "' has no unit: missing units row (units go in a row under the names "
+                                               "or in the names, e.g. 'Load (N)')");
+    col.quantity = ExportQuantity::strain;
+    col.to_si = 1.0;
+  } else {
+    const auto info = unit_info(lower(col.unit));
+    if (!info)
+      throw InputError(t.at(b.units_line ? *b.units_line : b.names_line),
+                       "column '" + col.name + "': unrecognised unit '" + col.unit +
+                           "' (known: s, ms, min, h; mm, m, cm, um, in; N, kN, mN, lbf, kgf; Pa, kPa, MPa, GPa, "
+                           "N/mm^2, psi; %, mm/mm, m/m, -)");
+    col.quantity = info->quantity;
+    col.to_si = info->to_si;
+  }
+  return col;
+}
+
+// The block's columns (names, units, SI factors), checked against the data rows' width.
+std::vector<ExportColumn> read_columns(const ExportText& t, const BlockLayout& b) {
+  const auto names = t.fields(b.names_line);
+  const size_t n_cols = used_fields(names);
+  const size_t data_fields = used_fields(t.fields(b.data_start));
+  if (n_cols != data_fields)
+    throw InputError(t.at(b.names_line), "the column names row has " + std::to_string(n_cols) + " field(s) with " +
+                                             sep_name(t.sep) + " as separator but the data rows have " +
+                                             std::to_string(data_fields) + " (wrong separator or missing names)");
+  std::vector<Field> units;
+  if (b.units_line) {
+    units = t.fields(*b.units_line);
+    if (used_fields(units) > n_cols)
+      throw InputError(t.at(*b.units_line), "the units row has more fields than the column names row");
+  }
+  std::vector<ExportColumn> columns;
+  for (size_t c = 0; c < n_cols; ++c)
+    columns.push_back(read_column(t, b, names[c], c < units.size() ? units[c].text : std::string(), c));
+  return columns;
+}
+
+// Data rows from b.data_start until a blank line followed by a non-number row (the
+// next block) or the end; returns the line after the block.
+size_t read_data_rows(const ExportText& t, const BlockLayout& b, std::vector<ExportColumn>& columns) {
+  std::vector<std::string> labels;
+  for (const auto& col : columns) labels.push_back(col.label);
+  size_t k = b.data_start;
+  bool blank_seen = false;
+  for (; k < t.lines.size(); ++k) {
+    const auto f = t.fields(k);
+    if (all_empty(f)) {
+      blank_seen = true;
+      continue;
+    }
+    if (blank_seen && !(numeric_row(f, t.sep) && used_fields(f) == columns.size())) break;
+    blank_seen = false;
+    parse_data_row(f, t.sep, t.lines[k], t.at(k), columns, labels);
+  }
+  return k;
+}
+
+// The specimen's label from the first header key that names one ("" if none).
+std::string specimen_label(const std::map<std::string, std::string>& header) {
+  std::string label;
+  for (const char* key : {"specimen label", "specimen name", "specimen", "sample", "name"}) {
+    for (const auto& [hk, hv] : header)
+      if (lower(hk) == key && !hv.empty()) label = hv;
+    if (!label.empty()) break;
+  }
+  return label;
+}
+
+// The block at b: header key/value pairs above the names, columns, data rows; `next`
+// is the line after it.
+SpecimenExport read_block(const ExportText& t, const BlockLayout& b, size_t& next) {
+  SpecimenExport block;
+  block.file = t.file;
+  block.first_line = static_cast<int>(b.start + 1);
+  for (size_t k = b.start; k < b.names_line; ++k) {
+    const auto f = t.fields(k);
+    if (f.size() >= 2 && !f[0].text.empty()) block.header[f[0].text] = f[1].text;
+  }
+  block.columns = read_columns(t, b);
+  next = read_data_rows(t, b, block.columns);
+  block.label = specimen_label(block.header);
+  return block;
+}
+
+}  // namespace
+
 std::vector<SpecimenExport> parse_test_machine_export(const std::string& text, const std::string& file) {
   const std::vector<std::string> lines = split_lines(text);
-  const char sep = detect_separator(lines, file);
-  auto at = [&](size_t i) { return file + ":" + std::to_string(i + 1); };
-
+  const ExportText t{lines, detect_separator(lines, file), file};
   std::vector<SpecimenExport> blocks;
   size_t i = 0;
   while (i < lines.size()) {
     // Skip blank lines between blocks.
-    while (i < lines.size() && all_empty(split(lines[i], sep))) ++i;
+    while (i < lines.size() && all_empty(t.fields(i))) ++i;
     if (i >= lines.size()) break;
-    const size_t block_start = i;
-    // Header, names and units: up to the first numeric row.
-    size_t data_start = i;
-    while (data_start < lines.size() && !numeric_row(split(lines[data_start], sep), sep)) ++data_start;
-    if (data_start == lines.size())
-      throw InputError(at(block_start), "specimen block without data rows (no line of numbers after it)");
-    std::vector<size_t> non_empty;
-    for (size_t k = block_start; k < data_start; ++k)
-      if (!all_empty(split(lines[k], sep))) non_empty.push_back(k);
-    if (non_empty.empty()) throw InputError(at(data_start), "no column names row before the data");
-
-    size_t names_line = non_empty.back();
-    std::optional<size_t> units_line;
-    {
-      const auto f = split(lines[names_line], sep);
-      const size_t n = used_fields(f);
-      bool units = n > 0;
-      for (size_t c = 0; c < n; ++c)
-        if (!f[c].text.empty() && !is_unit_cell(f[c].text)) units = false;
-      if (units) {
-        if (non_empty.size() < 2) throw InputError(at(names_line), "a units row without a column names row above it");
-        units_line = names_line;
-        names_line = non_empty[non_empty.size() - 2];
-      }
-    }
-    SpecimenExport block;
-    block.file = file;
-    block.first_line = static_cast<int>(block_start + 1);
-    for (size_t k = block_start; k < names_line; ++k) {
-      const auto f = split(lines[k], sep);
-      if (f.size() >= 2 && !f[0].text.empty()) block.header[f[0].text] = f[1].text;
-    }
-    const auto names = split(lines[names_line], sep);
-    const size_t n_cols = used_fields(names);
-    const size_t data_fields = used_fields(split(lines[data_start], sep));
-    if (n_cols != data_fields)
-      throw InputError(at(names_line), "the column names row has " + std::to_string(n_cols) + " field(s) with " +
-                                           sep_name(sep) + " as separator but the data rows have " +
-                                           std::to_string(data_fields) + " (wrong separator or missing names)");
-    std::vector<Field> units;
-    if (units_line) {
-      units = split(lines[*units_line], sep);
-      if (used_fields(units) > n_cols)
-        throw InputError(at(*units_line), "the units row has more fields than the column names row");
-    }
-    std::vector<std::string> labels;
-    for (size_t c = 0; c < n_cols; ++c) {
-      ExportColumn col;
-      col.label = names[c].text;
-      if (col.label.empty()) throw InputError(at(names_line), "column " + std::to_string(c + 1) + " has no name");
-      name_and_unit(col.label, col.name, col.unit);
-      if (units_line && c < units.size() && !units[c].text.empty()) {
-        col.unit = strip_brackets(units[c].text);
-        col.label += " (" + col.unit + ")";
-      }
-      const bool strain_name = lower(col.name).find("strain") != std::string::npos;
-      if (col.unit.empty()) {
-        if (!strain_name)
-          throw InputError(at(names_line), "column '" + col.name +
-                                               "' has no unit: missing units row (units go in a row under the names "
-                                               "or in the names, e.g. 'Load (N)')");
-        col.quantity = ExportQuantity::strain;
-        col.to_si = 1.0;
-      } else {
-        const auto info = unit_info(lower(col.unit));
-        if (!info)
-          throw InputError(at(units_line ? *units_line : names_line),
-                           "column '" + col.name + "': unrecognised unit '" + col.unit +
-                               "' (known: s, ms, min, h; mm, m, cm, um, in; N, kN, mN, lbf, kgf; Pa, kPa, MPa, GPa, "
-                               "N/mm^2, psi; %, mm/mm, m/m, -)");
-        col.quantity = info->quantity;
-        col.to_si = info->to_si;
-      }
-      labels.push_back(col.label);
-      block.columns.push_back(col);
-    }
-    // Data rows until a blank line followed by a non-number row (next block) or the end.
-    size_t k = data_start;
-    bool blank_seen = false;
-    for (; k < lines.size(); ++k) {
-      const auto f = split(lines[k], sep);
-      if (all_empty(f)) {
-        blank_seen = true;
-        continue;
-      }
-      if (blank_seen && !(numeric_row(f, sep) && used_fields(f) == n_cols)) break;
-      blank_seen = false;
-      parse_data_row(f, sep, lines[k], at(k), block.columns, labels);
-    }
-    for (const char* key : {"specimen label", "specimen name", "specimen", "sample", "name"}) {
-      for (const auto& [hk, hv] : block.header)
-        if (lower(hk) == key && !hv.empty()) block.label = hv;
-      if (!block.label.empty()) break;
-    }
-    blocks.push_back(std::move(block));
-    i = k;
+    blocks.push_back(read_block(t, locate_block(t, i), i));
   }
   if (blocks.empty()) throw InputError(file, "no specimen blocks");
   const std::string stem = std::filesystem::path(file).stem().string();
