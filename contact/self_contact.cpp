@@ -418,110 +418,143 @@ Eigen::Matrix<double, 4, 3> SelfContactTerm::positions(const std::array<int, 4>&
 // (only pairs whose smallest node this rank owns). With far nodes (R > r/2) the
 // grids reach dhat + 2R and every rank measures every pair out to there, so the trust
 // radii are the same on every rank.
-void SelfContactTerm::build_candidates(const RowMatrixXd& x) {
-  pairs_.clear();
-  edge_pairs_.clear();
-  const double reach = spec_.dhat + spec_.inflation;              // candidates
-  const double search = spec_.dhat + 2 * spec_.max_trust_radius;  // trust radii (>= reach)
-  const bool far = search > reach;
-  // Nearest non-candidate distance per node, then rho = min((d - dhat)/2, R).
-  std::vector<double> nearest(mesh_.n_nodes(), std::numeric_limits<double>::infinity());
-  const auto note = [&](double d, const auto&... nodes) { ((nearest[nodes] = std::min(nearest[nodes], d)), ...); };
-  const auto box = [&](const auto& nodes, Eigen::Vector3d& lo, Eigen::Vector3d& hi) {
-    lo = x.row(nodes[0]);
-    hi = lo;
-    for (size_t i = 1; i < nodes.size(); ++i) {
-      lo = lo.cwiseMin(x.row(nodes[i]).transpose());
-      hi = hi.cwiseMax(x.row(nodes[i]).transpose());
-    }
-  };
+namespace {
+
+// Axis-aligned bounding box [lo, hi] of the positions x of `nodes` [m].
+template <class Nodes>
+void bounding_box(const RowMatrixXd& x, const Nodes& nodes, Eigen::Vector3d& lo, Eigen::Vector3d& hi) {
+  lo = x.row(nodes[0]);
+  hi = lo;
+  for (size_t i = 1; i < nodes.size(); ++i) {
+    lo = lo.cwiseMin(x.row(nodes[i]).transpose());
+    hi = hi.cwiseMax(x.row(nodes[i]).transpose());
+  }
+}
+
+}  // namespace
+
+// One candidate search: pairs closer than reach = dhat + inflation are candidates;
+// pairs closer than search = dhat + 2 R_max but not candidates bound the trust radii
+// through the nearest non-candidate distance per node.
+struct SelfContactTerm::CandidateSearch {
+  double reach = 0, search = 0;  // [m]
+  bool far = false;              // search > reach: pairs of other ranks bound the radii too
+  std::vector<double> nearest;   // per mesh node: nearest non-candidate distance [m]
   std::set<std::tuple<int, int, int, int>> seen;
   std::set<std::array<int, 4>> seen_edges;
-  for (const auto& [side_a, side_b] : sides_) {
-    for (const auto& [points, tris] : {std::pair{&side_a, &side_b}, std::pair{&side_b, &side_a}}) {
-      double size = search;
-      for (const auto& t : tris->triangles)
-        for (int i = 0; i < 3; ++i) size = std::max(size, (x.row(t[i]) - x.row(t[(i + 1) % 3])).cwiseAbs().maxCoeff());
-      BoxGrid grid(size);
-      for (size_t t = 0; t < tris->triangles.size(); ++t) {
-        Eigen::Vector3d lo, hi;
-        box(tris->triangles[t], lo, hi);
-        grid.insert(static_cast<int>(t), (lo.array() - search).matrix(), (hi.array() + search).matrix());
-      }
-      for (int p : points->points) {
-        const bool owned = p >= rank_begin_ && p < rank_end_;
-        if (!owned && !far) continue;
-        const std::vector<int>* listed = grid.at(x.row(p).transpose());
-        if (listed == nullptr) continue;
-        for (int t : *listed) {
-          const auto& tri = tris->triangles[t];
-          const int face = tris->triangle_face[t];
-          bool own = false;
-          for (int a = 0; a < mesh_.nodes_per_face(); ++a) own = own || mesh_.faces(face, a) == p;
-          if (own) continue;
-          Eigen::Matrix<double, 4, 3> xs;
-          xs.row(0) = x.row(p);
-          for (int i = 0; i < 3; ++i) xs.row(i + 1) = x.row(tri[i]);
-          const double d = plain_distance(xs);
-          if (d >= search) continue;
-          if (d >= reach) {
-            note(d, p, tri[0], tri[1], tri[2]);
-          } else if (owned && seen.insert({p, tri[0], tri[1], tri[2]}).second) {
-            pairs_.push_back(Pair{p, tri});
-          }
-        }
-      }
-    }
-    if (!spec_.edge_edge) continue;
-    // Edge pairs: edges of B in every cell their inflated box touches; each edge of
-    // A looks in the cells of its own box (cells at least as large as any edge).
-    double size = search;
-    for (const auto& e : side_b.edges) size = std::max(size, (x.row(e[0]) - x.row(e[1])).cwiseAbs().maxCoeff());
-    for (const auto& e : side_a.edges) size = std::max(size, (x.row(e[0]) - x.row(e[1])).cwiseAbs().maxCoeff());
-    BoxGrid grid(size);
-    for (size_t k = 0; k < side_b.edges.size(); ++k) {
-      Eigen::Vector3d lo, hi;
-      box(side_b.edges[k], lo, hi);
-      grid.insert(static_cast<int>(k), (lo.array() - search).matrix(), (hi.array() + search).matrix());
-    }
-    std::set<int> near;
-    for (size_t ka = 0; ka < side_a.edges.size(); ++ka) {
-      const auto& ea = side_a.edges[ka];
-      Eigen::Vector3d lo, hi;
-      box(ea, lo, hi);
-      near.clear();
-      grid.near(lo, hi, near);
-      for (int kb : near) {
-        const auto& eb = side_b.edges[kb];
-        if (ea[0] == eb[0] || ea[0] == eb[1] || ea[1] == eb[0] || ea[1] == eb[1]) continue;
-        const int smallest = std::min(std::min(ea[0], ea[1]), std::min(eb[0], eb[1]));
-        const bool owned = smallest >= rank_begin_ && smallest < rank_end_;
-        if (!owned && !far) continue;
-        bool shared_face = false;
-        for (int f : side_a.edge_faces[ka])
-          for (int g : side_b.edge_faces[kb]) shared_face = shared_face || f == g;
-        if (shared_face) continue;
-        // One orientation per unordered pair (the same surface on both sides).
-        const std::array<int, 4> key =
-            ea < eb ? std::array<int, 4>{ea[0], ea[1], eb[0], eb[1]} : std::array<int, 4>{eb[0], eb[1], ea[0], ea[1]};
-        Eigen::Matrix<double, 4, 3> xs;
-        for (int i = 0; i < 4; ++i) xs.row(i) = x.row(key[i]);
-        const double d = plain_edge_distance(xs);
-        if (d >= search) continue;
-        if (d >= reach) {
-          note(d, key[0], key[1], key[2], key[3]);
-          continue;
-        }
-        if (!owned || !seen_edges.insert(key).second) continue;
-        Eigen::Matrix<double, 4, 3> xref;
-        for (int i = 0; i < 4; ++i) xref.row(i) = mesh_.X.row(key[i]);
-        edge_pairs_.push_back(EdgePair{key, 0.5 * (side_a.edge_weight[ka] + side_b.edge_weight[kb]),
-                                       edge_edge_mollifier_threshold(xref)});
+
+  template <class... Nodes>
+  void note(double d, Nodes... nodes) {
+    ((nearest[nodes] = std::min(nearest[nodes], d)), ...);
+  }
+};
+
+// Points of `points` against triangles of `tris`: triangles in every cell their box
+// inflated by `search` touches; each point looks in its own cell (cells at least as
+// large as any triangle edge).
+void SelfContactTerm::point_triangle_candidates(const Side& points, const Side& tris, const RowMatrixXd& x,
+                                                CandidateSearch& s) {
+  double size = s.search;
+  for (const auto& t : tris.triangles)
+    for (int i = 0; i < 3; ++i) size = std::max(size, (x.row(t[i]) - x.row(t[(i + 1) % 3])).cwiseAbs().maxCoeff());
+  BoxGrid grid(size);
+  for (size_t t = 0; t < tris.triangles.size(); ++t) {
+    Eigen::Vector3d lo, hi;
+    bounding_box(x, tris.triangles[t], lo, hi);
+    grid.insert(static_cast<int>(t), (lo.array() - s.search).matrix(), (hi.array() + s.search).matrix());
+  }
+  for (int p : points.points) {
+    const bool owned = p >= rank_begin_ && p < rank_end_;
+    if (!owned && !s.far) continue;
+    const std::vector<int>* listed = grid.at(x.row(p).transpose());
+    if (listed == nullptr) continue;
+    for (int t : *listed) {
+      const auto& tri = tris.triangles[t];
+      const int face = tris.triangle_face[t];
+      bool own = false;
+      for (int a = 0; a < mesh_.nodes_per_face(); ++a) own = own || mesh_.faces(face, a) == p;
+      if (own) continue;
+      Eigen::Matrix<double, 4, 3> xs;
+      xs.row(0) = x.row(p);
+      for (int i = 0; i < 3; ++i) xs.row(i + 1) = x.row(tri[i]);
+      const double d = plain_distance(xs);
+      if (d >= s.search) continue;
+      if (d >= s.reach) {
+        s.note(d, p, tri[0], tri[1], tri[2]);
+      } else if (owned && s.seen.insert({p, tri[0], tri[1], tri[2]}).second) {
+        pairs_.push_back(Pair{p, tri});
       }
     }
   }
+}
+
+// Edge pairs: edges of B in every cell their inflated box touches; each edge of A
+// looks in the cells of its own box (cells at least as large as any edge). Edges
+// sharing a node or a face are skipped; A_ee' = (A_e + A_e') / 2.
+void SelfContactTerm::edge_edge_candidates(const Side& side_a, const Side& side_b, const RowMatrixXd& x,
+                                           CandidateSearch& s) {
+  double size = s.search;
+  for (const auto& e : side_b.edges) size = std::max(size, (x.row(e[0]) - x.row(e[1])).cwiseAbs().maxCoeff());
+  for (const auto& e : side_a.edges) size = std::max(size, (x.row(e[0]) - x.row(e[1])).cwiseAbs().maxCoeff());
+  BoxGrid grid(size);
+  for (size_t k = 0; k < side_b.edges.size(); ++k) {
+    Eigen::Vector3d lo, hi;
+    bounding_box(x, side_b.edges[k], lo, hi);
+    grid.insert(static_cast<int>(k), (lo.array() - s.search).matrix(), (hi.array() + s.search).matrix());
+  }
+  std::set<int> near;
+  for (size_t ka = 0; ka < side_a.edges.size(); ++ka) {
+    const auto& ea = side_a.edges[ka];
+    Eigen::Vector3d lo, hi;
+    bounding_box(x, ea, lo, hi);
+    near.clear();
+    grid.near(lo, hi, near);
+    for (int kb : near) {
+      const auto& eb = side_b.edges[kb];
+      if (ea[0] == eb[0] || ea[0] == eb[1] || ea[1] == eb[0] || ea[1] == eb[1]) continue;
+      const int smallest = std::min(std::min(ea[0], ea[1]), std::min(eb[0], eb[1]));
+      const bool owned = smallest >= rank_begin_ && smallest < rank_end_;
+      if (!owned && !s.far) continue;
+      bool shared_face = false;
+      for (int f : side_a.edge_faces[ka])
+        for (int g : side_b.edge_faces[kb]) shared_face = shared_face || f == g;
+      if (shared_face) continue;
+      // One orientation per unordered pair (the same surface on both sides).
+      const std::array<int, 4> key =
+          ea < eb ? std::array<int, 4>{ea[0], ea[1], eb[0], eb[1]} : std::array<int, 4>{eb[0], eb[1], ea[0], ea[1]};
+      Eigen::Matrix<double, 4, 3> xs;
+      for (int i = 0; i < 4; ++i) xs.row(i) = x.row(key[i]);
+      const double d = plain_edge_distance(xs);
+      if (d >= s.search) continue;
+      if (d >= s.reach) {
+        s.note(d, key[0], key[1], key[2], key[3]);
+        continue;
+      }
+      if (!owned || !s.seen_edges.insert(key).second) continue;
+      Eigen::Matrix<double, 4, 3> xref;
+      for (int i = 0; i < 4; ++i) xref.row(i) = mesh_.X.row(key[i]);
+      edge_pairs_.push_back(
+          EdgePair{key, 0.5 * (side_a.edge_weight[ka] + side_b.edge_weight[kb]), edge_edge_mollifier_threshold(xref)});
+    }
+  }
+}
+
+void SelfContactTerm::build_candidates(const RowMatrixXd& x) {
+  pairs_.clear();
+  edge_pairs_.clear();
+  CandidateSearch s;
+  s.reach = spec_.dhat + spec_.inflation;              // candidates
+  s.search = spec_.dhat + 2 * spec_.max_trust_radius;  // trust radii (>= reach)
+  s.far = s.search > s.reach;
+  s.nearest.assign(mesh_.n_nodes(), std::numeric_limits<double>::infinity());
+  for (const auto& [side_a, side_b] : sides_) {
+    point_triangle_candidates(side_a, side_b, x, s);
+    point_triangle_candidates(side_b, side_a, x, s);
+    if (spec_.edge_edge) edge_edge_candidates(side_a, side_b, x, s);
+  }
+  // rho = min((d - dhat)/2, R) with d the nearest non-candidate distance.
   trust_radius_.assign(mesh_.n_nodes(), 0.0);
-  for (int a : surface_nodes_) trust_radius_[a] = std::min(0.5 * (nearest[a] - spec_.dhat), spec_.max_trust_radius);
+  for (int a : surface_nodes_) trust_radius_[a] = std::min(0.5 * (s.nearest[a] - spec_.dhat), spec_.max_trust_radius);
 }
 
 void SelfContactTerm::piece_nodes(int k, std::vector<int>& nodes) const {

@@ -200,6 +200,9 @@ class SelfContactTerm : public EnergyTerm {
     std::vector<std::vector<int>> edge_faces;  // parent faces of each edge
     std::vector<double> edge_weight;           // A_e [m^2]
   };
+  struct CandidateSearch;  // the state of one build_candidates (self_contact.cpp)
+  void point_triangle_candidates(const Side& points, const Side& tris, const RowMatrixXd& x, CandidateSearch& search);
+  void edge_edge_candidates(const Side& side_a, const Side& side_b, const RowMatrixXd& x, CandidateSearch& search);
   std::vector<std::pair<Side, Side>> sides_;
   std::vector<Pair> pairs_;                     // owned pairs (owner of the point)
   std::vector<EdgePair> edge_pairs_;            // owned edge pairs (owner of the smallest node)
