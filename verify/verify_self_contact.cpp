@@ -190,13 +190,10 @@ RowMatrixXd term_forces(const EnergyTerm& term, const Mesh& mesh, const RowMatri
   return force;
 }
 
-}  // namespace
-
-TubeVacuumResult run_tube_vacuum(double h, int order, MPI_Comm comm, bool progress, BarrierHessian hessian) {
-  int rank;
-  MPI_Comm_rank(comm, &rank);
-  // The mesh is built once on rank 0 and handed to the scene as a .msh file
-  // (named after rank 0's process id, the same name on every rank).
+// Writes the tube mesh on rank 0 to a temporary .msh file (named after rank 0's
+// process id, the same name on every rank) and returns its path; SolveError on every
+// rank if rank 0 fails.
+std::string write_tube_mesh(double h, int order, MPI_Comm comm, int rank) {
   int pid = static_cast<int>(getpid());
   MPI_Bcast(&pid, 1, MPI_INT, 0, comm);
   const std::string path = (std::filesystem::temp_directory_path() /
@@ -213,10 +210,15 @@ TubeVacuumResult run_tube_vacuum(double h, int order, MPI_Comm comm, bool progre
   int failed = !error.empty();
   MPI_Bcast(&failed, 1, MPI_INT, 0, comm);
   if (failed) throw SolveError("tube_vacuum: mesh generation failed on rank 0: " + error);
+  return path;
+}
 
+// The tube on `mesh_file`: symmetric and clamped faces, the lumen evacuated to
+// kVacuum over t in [0, 1], and self-contact between the lumen's walls.
+Scene tube_vacuum_scene(const std::string& mesh_file, BarrierHessian hessian) {
   Scene s;
   s.name = "tube_vacuum";
-  s.mesh_file = path;
+  s.mesh_file = mesh_file;
   s.materials["body"] = verification_params({{"mu", kMu}, {"kappa", 10 * kMu}}, "model", "neo_hookean");
   for (auto [surface, axis] :
        std::vector<std::pair<const char*, int>>{{"sym_x", 0}, {"ymin", 1}, {"ymax", 1}, {"edge", 2}}) {
@@ -249,6 +251,53 @@ TubeVacuumResult run_tube_vacuum(double h, int order, MPI_Comm comm, bool progre
   s.solver.max_newton_its = 15;   // a stalled solve is cut early (retried with a smaller step)
   s.solver.easy_newton_its = 12;  // contact steps take ~10 Newton iterations: still grow the step
   s.solver.grow = 2.0;
+  return s;
+}
+
+// Contact against vacuum load in the flattened region (virtual work, header): the
+// ratio of the contact and vacuum forces on cavity_top weighted by w(X) = 1 up to
+// X1 = W/4, 0 beyond X2 = W/2, linear between; the fraction of cavity_top's nodes up
+// to X2 in contact (gap < dhat); the largest motion of a lumen node [m].
+void measure_flattened_contact(const Scene& s, const SimulationResult& r, TubeVacuumResult& out) {
+  const Mesh& mesh = r.mesh;
+  Partition serial;
+  serial.cell_part.assign(mesh.n_cells(), 0);
+  serial.node_begin = {0, mesh.n_nodes()};
+  SelfContactTerm contact(mesh, serial, 0, s.self_contact_spec);
+  contact.refresh(r.u);
+  const SelfContactNodal c = contact.nodal_contact(r.u);
+  CavityPressureTerm vacuum(mesh, serial, 0, s.cavities.front());
+  vacuum.set_time(s.solver.t_end);
+  out.vacuum = -vacuum.pressure();
+  const RowMatrixXd f_vacuum = term_forces(vacuum, mesh, r.u);
+  const double X1 = 0.25 * kW, X2 = 0.5 * kW;
+  double contact_work = 0, vacuum_work = 0;
+  int in_region = 0, touching = 0;
+  for (int n : mesh.nodes_of_surface("cavity_top")) {
+    const double X = mesh.X(n, 0);
+    const double w = X <= X1 ? 1.0 : X >= X2 ? 0.0 : (X2 - X) / (X2 - X1);
+    contact_work += w * c.force(n, 2);
+    vacuum_work += w * f_vacuum(n, 2);
+    if (X <= X2) {
+      ++in_region;
+      touching += c.gap[n] < kDhat;
+    }
+  }
+  out.pressure_ratio = vacuum_work != 0 ? contact_work / -vacuum_work : 0.0;
+  out.contact_fraction = in_region > 0 ? double(touching) / in_region : 0.0;
+  for (const char* surface : {"cavity_top", "cavity_bottom"})
+    for (int n : mesh.nodes_of_surface(surface))
+      out.max_surface_motion = std::max(out.max_surface_motion, r.u.row(n).norm());
+}
+
+}  // namespace
+
+TubeVacuumResult run_tube_vacuum(double h, int order, MPI_Comm comm, bool progress, BarrierHessian hessian) {
+  int rank;
+  MPI_Comm_rank(comm, &rank);
+  // The mesh is built once on rank 0 and handed to the scene as a .msh file.
+  const std::string path = write_tube_mesh(h, order, comm, rank);
+  const Scene s = tube_vacuum_scene(path, hessian);
 
   TubeVacuumResult out;
   out.min_distance = out.min_J = std::numeric_limits<double>::infinity();
@@ -272,37 +321,7 @@ TubeVacuumResult run_tube_vacuum(double h, int order, MPI_Comm comm, bool progre
   out.stats = r.stats;
   out.dofs = r.dofs;
   require_completed(r, "tube flattened by vacuum");
-
-  // Contact against vacuum load in the flattened region (virtual work, header).
-  const Mesh& mesh = r.mesh;
-  Partition serial;
-  serial.cell_part.assign(mesh.n_cells(), 0);
-  serial.node_begin = {0, mesh.n_nodes()};
-  SelfContactTerm contact(mesh, serial, 0, s.self_contact_spec);
-  contact.refresh(r.u);
-  const SelfContactNodal c = contact.nodal_contact(r.u);
-  CavityPressureTerm vacuum(mesh, serial, 0, cavity);
-  vacuum.set_time(s.solver.t_end);
-  out.vacuum = -vacuum.pressure();
-  const RowMatrixXd f_vacuum = term_forces(vacuum, mesh, r.u);
-  const double X1 = 0.25 * kW, X2 = 0.5 * kW;
-  double contact_work = 0, vacuum_work = 0;
-  int in_region = 0, touching = 0;
-  for (int n : mesh.nodes_of_surface("cavity_top")) {
-    const double X = mesh.X(n, 0);
-    const double w = X <= X1 ? 1.0 : X >= X2 ? 0.0 : (X2 - X) / (X2 - X1);
-    contact_work += w * c.force(n, 2);
-    vacuum_work += w * f_vacuum(n, 2);
-    if (X <= X2) {
-      ++in_region;
-      touching += c.gap[n] < kDhat;
-    }
-  }
-  out.pressure_ratio = vacuum_work != 0 ? contact_work / -vacuum_work : 0.0;
-  out.contact_fraction = in_region > 0 ? double(touching) / in_region : 0.0;
-  for (const char* surface : {"cavity_top", "cavity_bottom"})
-    for (int n : mesh.nodes_of_surface(surface))
-      out.max_surface_motion = std::max(out.max_surface_motion, r.u.row(n).norm());
+  measure_flattened_contact(s, r, out);
   return out;
 }
 
