@@ -135,6 +135,75 @@ void name_gap_faces(Mesh& mesh, const std::vector<Cavity>& gaps, double tol) {
   }
 }
 
+// Volume fragments by region: the piece containing each fragment's centre of mass
+// gives its region.
+struct AssemblyVolumes {
+  std::map<std::string, std::vector<int>> tags;  // region -> volume tags
+  std::map<int, std::string> region_of_volume;
+};
+AssemblyVolumes assembly_volumes(const Assembly& assembly, double tol) {
+  namespace occ = gmsh::model::occ;
+  AssemblyVolumes out;
+  gmsh::vectorpair volumes;
+  gmsh::model::getEntities(volumes, 3);
+  for (const auto& [dim, tag] : volumes) {
+    double x, y, z;
+    occ::getCenterOfMass(dim, tag, x, y, z);
+    auto piece = std::find_if(assembly.pieces.begin(), assembly.pieces.end(),
+                              [&](const Piece& p) { return p.box.contains(Vec3(x, y, z), tol); });
+    if (piece == assembly.pieces.end()) throw std::logic_error("robot geometry: a fragment lies in no piece");
+    out.tags[piece->region].push_back(tag);
+    out.region_of_volume[tag] = piece->region;
+  }
+  return out;
+}
+
+// An outside boundary surface (no cavity) by material, for friction: "bottom" or
+// "outer" by the side the solid is on (probed `probe` along its normal), then a foot
+// (foot_a, foot_b), else a bladder's or the skin's surface; end faces (normal along y)
+// at y = 0 and y = length also go to end_a and end_b.
+void name_outside_surface(const Assembly& assembly, int tag, const SurfaceSample& s, bool bladder, double tol,
+                          double probe, std::map<std::string, std::vector<int>>& surface_tags) {
+  bool foot = false;
+  Vec3 step = Vec3::Zero();
+  step(s.axis) = probe;
+  const bool solid_below = inside_solid(assembly, s.point - step), solid_above = inside_solid(assembly, s.point + step);
+  if (solid_below == solid_above) throw std::logic_error("robot geometry: cannot orient a boundary surface");
+  const bool faces_down = s.axis == 2 && solid_above;
+  surface_tags[faces_down ? "bottom" : "outer"].push_back(tag);
+  const bool in_foot_plane = faces_down && std::abs(s.nodes.hi.z() - assembly.foot_z) <= tol &&
+                             std::abs(s.nodes.lo.z() - assembly.foot_z) <= tol;
+  // A side or end face of the foot layer: when the body arches it stands on the
+  // foot's outer edge, whose friction must then be the foot's, not the skin's.
+  const bool foot_layer_side = !bladder && s.axis != 2 && assembly.foot_top_z > assembly.foot_z + tol &&
+                               s.nodes.lo.z() >= assembly.foot_z - tol && s.nodes.hi.z() <= assembly.foot_top_z + tol;
+  if (in_foot_plane || foot_layer_side) {
+    if (s.nodes.hi.y() <= assembly.foot_length + tol) {
+      surface_tags["foot_a"].push_back(tag);
+      foot = true;
+    }
+    if (s.nodes.lo.y() >= assembly.length - assembly.foot_length - tol) {
+      surface_tags["foot_b"].push_back(tag);
+      foot = true;
+    }
+  }
+  if (!foot) surface_tags[bladder ? "bladder_surface" : "skin_surface"].push_back(tag);
+  // The end faces (normal along y) at y = 0 and y = length, for slices in plane strain.
+  if (s.axis == 1 && s.nodes.hi.y() <= tol) surface_tags["end_a"].push_back(tag);
+  if (s.axis == 1 && s.nodes.lo.y() >= assembly.length - tol) surface_tags["end_b"].push_back(tag);
+}
+
+// The boundary regions in the order they are declared: cavities, then the outside
+// surfaces (no feet without a foot length), then the fabric sheet if any.
+std::vector<std::string> surface_order(const Assembly& assembly) {
+  std::vector<std::string> order;
+  for (const Cavity& c : assembly.cavities) order.push_back(c.surface);
+  for (const char* name : {"bottom", "foot_a", "foot_b", "outer", "skin_surface", "bladder_surface", "end_a", "end_b"})
+    if (assembly.foot_length > 0 || std::string(name).rfind("foot_", 0) != 0) order.push_back(name);  // no feet
+  if (!assembly.sheet_z.empty()) order.push_back("fabric_sheet");
+  return order;
+}
+
 // Mesh errors name the scene's geometry (or "geometry TYPE"); a geometry gmsh cannot
 // mesh names the mesh_size key's location.
 Mesh mesh_assembly(const Assembly& assembly, double mesh_size, int order, const ParamSet& params,
@@ -154,20 +223,8 @@ Mesh mesh_assembly(const Assembly& assembly, double mesh_size, int order, const 
   occ::synchronize();
   const double tol = 1e-9 * assembly.scale, probe = 1e-6 * assembly.scale;
 
-  // Volumes: the piece containing each fragment's centre of mass gives its region.
-  std::map<std::string, std::vector<int>> volume_tags;
-  std::map<int, std::string> region_of_volume;
-  gmsh::vectorpair volumes;
-  gmsh::model::getEntities(volumes, 3);
-  for (const auto& [dim, tag] : volumes) {
-    double x, y, z;
-    occ::getCenterOfMass(dim, tag, x, y, z);
-    auto piece = std::find_if(assembly.pieces.begin(), assembly.pieces.end(),
-                              [&](const Piece& p) { return p.box.contains(Vec3(x, y, z), tol); });
-    if (piece == assembly.pieces.end()) throw std::logic_error("robot geometry: a fragment lies in no piece");
-    volume_tags[piece->region].push_back(tag);
-    region_of_volume[tag] = piece->region;
-  }
+  AssemblyVolumes volumes = assembly_volumes(assembly, tol);
+  const std::map<int, std::string>& region_of_volume = volumes.region_of_volume;
   std::vector<VolumeSize> refine;
   if (assembly.chamber_size > 0) {
     refine.push_back({{}, assembly.chamber_size});
@@ -175,7 +232,7 @@ Mesh mesh_assembly(const Assembly& assembly, double mesh_size, int order, const 
       if (region.rfind("bladder_", 0) == 0) refine.back().volumes.push_back(tag);
   }
   generate_tet_mesh(mesh_size, order, params.where("mesh_size"), refine);
-  for (const std::string& name : assembly.volume_order) add_group(3, volume_tags[name], name);
+  for (const std::string& name : assembly.volume_order) add_group(3, volumes.tags[name], name);
 
   // Boundary surfaces (one adjacent volume).
   std::map<std::string, std::vector<int>> surface_tags;
@@ -199,43 +256,10 @@ Mesh mesh_assembly(const Assembly& assembly, double mesh_size, int order, const 
       surface_tags[cavity->surface].push_back(tag);
       continue;
     }
-    // Outside surfaces by material, for friction: a bladder's, or the skin's other than the feet.
-    const bool bladder = region_of_volume.at(up[0]).rfind("bladder_", 0) == 0;
-    bool foot = false;
-    Vec3 step = Vec3::Zero();
-    step(s.axis) = probe;
-    const bool solid_below = inside_solid(assembly, s.point - step),
-               solid_above = inside_solid(assembly, s.point + step);
-    if (solid_below == solid_above) throw std::logic_error("robot geometry: cannot orient a boundary surface");
-    const bool faces_down = s.axis == 2 && solid_above;
-    surface_tags[faces_down ? "bottom" : "outer"].push_back(tag);
-    const bool in_foot_plane = faces_down && std::abs(s.nodes.hi.z() - assembly.foot_z) <= tol &&
-                               std::abs(s.nodes.lo.z() - assembly.foot_z) <= tol;
-    // A side or end face of the foot layer: when the body arches it stands on the
-    // foot's outer edge, whose friction must then be the foot's, not the skin's.
-    const bool foot_layer_side = !bladder && s.axis != 2 && assembly.foot_top_z > assembly.foot_z + tol &&
-                                 s.nodes.lo.z() >= assembly.foot_z - tol && s.nodes.hi.z() <= assembly.foot_top_z + tol;
-    if (in_foot_plane || foot_layer_side) {
-      if (s.nodes.hi.y() <= assembly.foot_length + tol) {
-        surface_tags["foot_a"].push_back(tag);
-        foot = true;
-      }
-      if (s.nodes.lo.y() >= assembly.length - assembly.foot_length - tol) {
-        surface_tags["foot_b"].push_back(tag);
-        foot = true;
-      }
-    }
-    if (!foot) surface_tags[bladder ? "bladder_surface" : "skin_surface"].push_back(tag);
-    // The end faces (normal along y) at y = 0 and y = length, for slices in plane strain.
-    if (s.axis == 1 && s.nodes.hi.y() <= tol) surface_tags["end_a"].push_back(tag);
-    if (s.axis == 1 && s.nodes.lo.y() >= assembly.length - tol) surface_tags["end_b"].push_back(tag);
+    name_outside_surface(assembly, tag, s, region_of_volume.at(up[0]).rfind("bladder_", 0) == 0, tol, probe,
+                         surface_tags);
   }
-  std::vector<std::string> surface_order;
-  for (const Cavity& c : assembly.cavities) surface_order.push_back(c.surface);
-  for (const char* name : {"bottom", "foot_a", "foot_b", "outer", "skin_surface", "bladder_surface", "end_a", "end_b"})
-    if (assembly.foot_length > 0 || std::string(name).rfind("foot_", 0) != 0) surface_order.push_back(name);  // no feet
-  if (!assembly.sheet_z.empty()) surface_order.push_back("fabric_sheet");
-  for (const std::string& name : surface_order) add_group(2, surface_tags[name], name);
+  for (const std::string& name : surface_order(assembly)) add_group(2, surface_tags[name], name);
 
   Mesh mesh = mesh_from_current_gmsh_model(source);
   if (!assembly.gaps.empty()) name_gap_faces(mesh, assembly.gaps, tol);
