@@ -2,7 +2,8 @@
 // build the same struct). A scene declares only the physics it needs; the
 // simulation builds only those energy terms.
 //
-// YAML layout (every key is checked; unknown keys are errors):
+// YAML layout (every key is declared in sim/scene_keys.h's table, printed as
+// docs/scene-keys.md; unknown keys and numbers outside their range are errors):
 //   name: demo
 //   geometry: {type: thick_cylinder, inner_radius: 0.01, ..., mesh_size: 0.002, order: 2}
 //   mesh: {file: body.msh}                      # instead of geometry
@@ -42,7 +43,9 @@
 //   solver: {end_time: 1, initial_step: 0.1, min_step: 1e-6, max_step: 1,
 //            linear_solver: mumps|gamg, quadrature_degree: 0, max_newton_its: 30,
 //            easy_newton_its: 6,   # a step that converged in at most this many iterations grows 1.5x
-//            formulation: displacement, hessian_projection: adaptive}
+//            formulation: displacement, hessian_projection: adaptive,
+//            newton_velocity_tol: 0,   # m/s; > 0: Newton also stops once no node moves faster
+//            extrapolate: true}        # Newton starts from the last step's velocity
 //            # hessian_projection: adaptive (default) = the exact Hessian after a full Newton
 //            # step, falling back to the projected one if it does not descend or the line
 //            # search fails along it; always = terms project their Hessians to PSD in every

@@ -7,7 +7,7 @@ namespace morphfem {
 namespace {
 
 void read_ground(const SceneReader& r, const YAML::Node& g, Scene& scene) {
-  r.allow(g, "contact.ground", {"point", "normal", "surfaces", "dhat", "kappa"});
+  r.allow(g, "contact.ground");
   scene.ground_contact = true;
   if (!g["surfaces"]) r.fail(g, "contact.ground", "missing key 'surfaces'");
   scene.ground.surfaces = r.texts(g["surfaces"], "contact.ground.surfaces");
@@ -21,7 +21,7 @@ void read_ground(const SceneReader& r, const YAML::Node& g, Scene& scene) {
 }
 
 FrictionRegion read_friction_region(const SceneReader& r, const YAML::Node& reg, double end) {
-  r.allow(reg, "contact.friction.regions", {"surface", "mu_static", "mu_kinetic", "mu"});
+  r.allow(reg, "contact.friction.regions");
   FrictionRegion region;
   if (!reg["surface"]) r.fail(reg, "contact.friction.regions", "missing key 'surface'");
   region.surface = r.text(reg["surface"], "contact.friction.regions.surface");
@@ -40,12 +40,11 @@ FrictionRegion read_friction_region(const SceneReader& r, const YAML::Node& reg,
 }
 
 void read_friction(const SceneReader& r, const YAML::Node& f, Scene& scene) {
-  r.allow(f, "contact.friction", {"eps_v", "lag_updates", "regions"});
+  r.allow(f, "contact.friction");
   if (!scene.ground_contact) r.fail(f, "contact.friction", "friction needs contact.ground");
   scene.friction = true;
-  r.optional_positive(f, "contact.friction", "eps_v", scene.friction_spec.eps_v);
-  if (f["lag_updates"])
-    scene.friction_spec.lag_updates = int(r.number(f["lag_updates"], "contact.friction.lag_updates"));
+  r.optional(f, "contact.friction", "eps_v", scene.friction_spec.eps_v);
+  r.optional(f, "contact.friction", "lag_updates", scene.friction_spec.lag_updates);
   if (!f["regions"] || !f["regions"].IsSequence())
     r.fail(f, "contact.friction", "missing 'regions: [{surface, mu_static, mu_kinetic}, ...]'");
   for (const auto& reg : f["regions"])
@@ -54,10 +53,10 @@ void read_friction(const SceneReader& r, const YAML::Node& f, Scene& scene) {
 
 void read_lattice_floor(const SceneReader& r, const YAML::Node& lf, Scene& scene) {
   const std::string key = "contact.lattice_floor";
-  r.allow(lf, key, {"point", "normal", "dhat", "kappa", "eps_v", "voxel_size", "mu", "gap_foot_columns"});
+  r.allow(lf, key);
   scene.lattice_floor = true;
   LatticeFloorScene& spec = scene.lattice_floor_spec;
-  if (lf["gap_foot_columns"]) spec.gap_foot_columns = r.flag(lf["gap_foot_columns"], key + ".gap_foot_columns");
+  r.optional(lf, key, "gap_foot_columns", spec.gap_foot_columns);
   if (lf["point"]) spec.floor.point = r.vector3(lf["point"], key + ".point");
   if (lf["normal"]) {
     spec.floor.normal = r.vector3(lf["normal"], key + ".normal");
@@ -65,25 +64,23 @@ void read_lattice_floor(const SceneReader& r, const YAML::Node& lf, Scene& scene
   }
   for (auto [k, value] : {std::pair{"dhat", &spec.floor.dhat}, std::pair{"eps_v", &spec.floor.eps_v},
                           std::pair{"voxel_size", &spec.voxel_size}})
-    r.optional_positive(lf, key, k, *value);
+    r.optional(lf, key, k, *value);
   if (!lf["kappa"]) r.fail(lf, key, "missing key 'kappa' (the barrier stiffness [Pa])");
-  r.optional_positive(lf, key, "kappa", spec.floor.kappa);
+  r.optional(lf, key, "kappa", spec.floor.kappa);
   const YAML::Node mu = lf["mu"];
   if (!mu || !mu.IsMap() || mu.size() == 0)
     r.fail(mu ? mu : lf, key + ".mu", "expected a map volume region -> friction coefficient, e.g. {skin: 2.0}");
   for (const auto& item : mu) {
     const std::string region = r.text(item.first, key + ".mu");
-    const double value = r.number(item.second, key + ".mu." + region);
-    if (!(value >= 0)) r.fail(item.second, key + ".mu." + region, "must not be negative");
-    spec.mu[region] = value;
+    spec.mu[region] = r.number(item.second, key + ".mu." + region);
   }
 }
 
 void read_self_contact(const SceneReader& r, const YAML::Node& sc, Scene& scene) {
   SelfContactSpec& spec = scene.self_contact_spec;
-  r.allow(sc, "contact.self", {"pairs", "dhat", "kappa", "inflation", "max_trust_radius", "start", "project_hessian"});
-  if (sc["start"]) spec.start = r.number(sc["start"], "contact.self.start");
-  if (sc["project_hessian"]) spec.project_hessian = r.flag(sc["project_hessian"], "contact.self.project_hessian");
+  r.allow(sc, "contact.self");
+  r.optional(sc, "contact.self", "start", spec.start);
+  r.optional(sc, "contact.self", "project_hessian", spec.project_hessian);
   scene.self_contact = true;
   const YAML::Node pairs = sc["pairs"];
   if (!pairs || !pairs.IsSequence() || pairs.size() == 0)
@@ -97,19 +94,15 @@ void read_self_contact(const SceneReader& r, const YAML::Node& sc, Scene& scene)
   // the default.
   for (auto [key, value] :
        {std::pair{"dhat", &spec.dhat}, std::pair{"kappa", &spec.kappa}, std::pair{"inflation", &spec.inflation},
-        std::pair{"max_trust_radius", &spec.max_trust_radius}}) {
-    if (!sc[key]) continue;
-    *value = r.number(sc[key], std::string("contact.self.") + key);
-    if (!(*value >= 0)) r.fail(sc[key], std::string("contact.self.") + key, "must not be negative");
-  }
+        std::pair{"max_trust_radius", &spec.max_trust_radius}})
+    r.optional(sc, "contact.self", key, *value);
 }
 
 }  // namespace
 
 void read_dynamics(const SceneReader& r, const YAML::Node& d, Scene& scene) {
   if (!d) return;
-  r.allow(d, "dynamics",
-          {"scheme", "lumped", "adaptive", "error_tolerance", "shear_viscosity", "bulk_viscosity", "initial_velocity"});
+  r.allow(d, "dynamics");
   scene.dynamic = true;
   if (d["scheme"]) {
     const std::string name = r.text(d["scheme"], "dynamics.scheme");
@@ -125,20 +118,15 @@ void read_dynamics(const SceneReader& r, const YAML::Node& d, Scene& scene) {
   };
   flag("lumped", scene.inertia.lumped);
   flag("adaptive", scene.inertia.adaptive);
-  auto nonnegative = [&](const char* key, double& out) {
-    if (!d[key]) return;
-    out = r.number(d[key], std::string("dynamics.") + key);
-    if (out < 0) r.fail(d[key], std::string("dynamics.") + key, "must not be negative");
-  };
-  nonnegative("error_tolerance", scene.inertia.error_tolerance);
-  nonnegative("shear_viscosity", scene.shear_viscosity);
-  nonnegative("bulk_viscosity", scene.bulk_viscosity);
+  r.optional(d, "dynamics", "error_tolerance", scene.inertia.error_tolerance);
+  r.optional(d, "dynamics", "shear_viscosity", scene.shear_viscosity);
+  r.optional(d, "dynamics", "bulk_viscosity", scene.bulk_viscosity);
   if (d["initial_velocity"]) scene.initial_velocity = r.vector3(d["initial_velocity"], "dynamics.initial_velocity");
 }
 
 void read_contact(const SceneReader& r, const YAML::Node& c, Scene& scene) {
   if (!c) return;
-  r.allow(c, "contact", {"ground", "friction", "self", "lattice_floor"});
+  r.allow(c, "contact");
   if (const auto g = c["ground"]) read_ground(r, g, scene);
   if (const auto f = c["friction"]) read_friction(r, f, scene);
   if (const auto lf = c["lattice_floor"]) read_lattice_floor(r, lf, scene);
