@@ -1,9 +1,11 @@
-// The scene-key table (sim/scene_keys.h): well formed, and the readers refuse what it
-// does not declare and check its ranges.
+// The scene-key table (sim/scene_keys.h): well formed, the readers refuse what it does
+// not declare and check its ranges, and docs/scene-keys.md is its current output.
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
+#include <fstream>
 #include <set>
+#include <sstream>
 #include <string>
 
 #include "core/errors.h"
@@ -40,6 +42,15 @@ std::string error_of(const std::string& extra) {
 }
 
 }  // namespace
+
+TEST(SceneKeys, TheDocumentationIsTheTablesOutput) {
+  std::ifstream in(std::string(MORPHFEM_SOURCE_DIR) + "/docs/scene-keys.md");
+  ASSERT_TRUE(in) << "docs/scene-keys.md is missing";
+  std::stringstream text;
+  text << in.rdbuf();
+  EXPECT_TRUE(text.str() == scene_keys_markdown())
+      << "docs/scene-keys.md differs from the table: build/app/morphfem scene-keys > docs/scene-keys.md";
+}
 
 TEST(SceneKeys, EveryKeyIsDeclaredOnceUnderADeclaredMapping) {
   std::set<std::string> paths;
