@@ -25,7 +25,7 @@ void add_gait_output_times(Scene& scene) {
 }
 
 void check_friction_scheme(const SceneReader& r, const YAML::Node& root, const Scene& scene) {
-  if (scene.friction && scene.dynamic && scene.inertia.scheme != TimeScheme::implicit_euler)
+  if (scene.friction && scene.dynamics && scene.dynamics->inertia.scheme != TimeScheme::implicit_euler)
     throw InputError(r.at(root["dynamics"]),
                      "'dynamics.scheme': friction needs implicit_euler (the friction potential is written with the "
                      "implicit-Euler slip u - u_n; with bdf2/newmark it would be inconsistent)");

@@ -164,6 +164,13 @@ struct LatticeFloorScene {
   std::optional<TimeFunction> gap_foot_mu;  // set by actuation.feet (voxel timing)
 };
 
+// dynamics: inertia and viscous damping (a scene without them is quasi-static).
+struct DynamicsSpec {
+  InertiaOptions inertia;                                      // time scheme, mass lumping, error control
+  double shear_viscosity = 0.0, bulk_viscosity = 0.0;          // [Pa s]
+  Eigen::Vector3d initial_velocity = Eigen::Vector3d::Zero();  // [m/s]
+};
+
 struct GaitSpec {
   bool enabled = false;
   double start = 0.0, end = 0.0;  // simulation times of the gait's first column and its end [s]
@@ -190,20 +197,12 @@ struct Scene {
   // manufactured solution's load), integrated with `body_force_degree`.
   std::function<Eigen::Vector3d(const Eigen::Vector3d& X, double t)> body_force;
   int body_force_degree = 4;
-  // Dynamics (inertia, viscous damping) — only if the scene asks for it.
-  bool dynamic = false;
-  InertiaOptions inertia;
-  double shear_viscosity = 0.0, bulk_viscosity = 0.0;          // [Pa s]
-  Eigen::Vector3d initial_velocity = Eigen::Vector3d::Zero();  // [m/s]
-  // Ground contact and friction — only if declared.
-  bool ground_contact = false;
-  GroundContactSpec ground;
-  bool friction = false;
-  FrictionSpec friction_spec;
-  bool lattice_floor = false;  // the voxel lattice's floor contact (a diagnostic, contact/lattice_floor.h)
-  LatticeFloorScene lattice_floor_spec;
-  bool self_contact = false;  // self-contact between declared surface pairs
-  SelfContactSpec self_contact_spec;
+  // Each present only if the scene declares it (the simulation builds only those terms).
+  std::optional<DynamicsSpec> dynamics;  // inertia and viscous damping
+  std::optional<GroundContactSpec> ground;
+  std::optional<FrictionSpec> friction;            // on the ground contact
+  std::optional<LatticeFloorScene> lattice_floor;  // the voxel lattice's floor contact (a diagnostic)
+  std::optional<SelfContactSpec> self_contact;     // between declared surface pairs
   std::string schedule_file;  // the actuation schedule, if any (its loads are in cavities/friction)
   // Values taken from calibration files (core/calibration_file.h), recorded in summary.json.
   struct CalibrationUse {

@@ -176,12 +176,12 @@ void ActuationReader::read_feet() {
   const auto f = a["feet"];
   if (!f) return;
   r.allow(f, key + ".feet");
-  if (!scene.ground_contact && !scene.lattice_floor)
+  if (!scene.ground && !scene.lattice_floor)
     r.fail(f, key + ".feet", "foot friction needs contact.ground (or contact.lattice_floor)");
   const double mu_active = f["mu_active"] ? r.calibrated_number(f["mu_active"], key + ".feet.mu_active") : 2.0;
   const double mu_inactive = f["mu_inactive"] ? r.calibrated_number(f["mu_inactive"], key + ".feet.mu_inactive") : 1e-4;
   // Ground contact: friction regions; the lattice floor only: its foot voxels.
-  scene.friction = scene.ground_contact;
+  if (scene.ground && !scene.friction) scene.friction.emplace();
   for (const auto &[foot, channel] :
        {std::pair<const char *, int>{"foot_a", kChannelFootA}, {"foot_b", kChannelFootB}}) {
     if (!f[foot]) continue;
@@ -189,13 +189,13 @@ void ActuationReader::read_feet() {
                                 ? voxel_foot_friction(schedule, channel, start, mu_active, mu_inactive, voxel)
                                 : foot_friction(schedule, channel, start, mu_active, mu_inactive);
     const std::string surface = r.text(f[foot], key + ".feet." + foot);
-    if (scene.ground_contact)
-      scene.friction_spec.regions.push_back({surface, mu, mu});
+    if (scene.ground)
+      scene.friction->regions.push_back({surface, mu, mu});
     else
-      scene.lattice_floor_spec.feet.push_back({surface, mu});
+      scene.lattice_floor->feet.push_back({surface, mu});
   }
-  LatticeFloorScene &lattice = scene.lattice_floor_spec;
-  if (lattice.gap_foot_columns && !scene.ground_contact) {
+  if (scene.lattice_floor && scene.lattice_floor->gap_foot_columns && !scene.ground) {
+    LatticeFloorScene &lattice = *scene.lattice_floor;
     if (timing != "voxel")
       r.fail(f, key + ".feet", "contact.lattice_floor.gap_foot_columns needs the voxel timing (growth actuation)");
     lattice.gap_foot_mu = voxel_gap_foot_friction(schedule, start, mu_active, mu_inactive, voxel);

@@ -8,16 +8,16 @@ namespace {
 
 void read_ground(const SceneReader& r, const YAML::Node& g, Scene& scene) {
   r.allow(g, "contact.ground");
-  scene.ground_contact = true;
+  GroundContactSpec& ground = scene.ground.emplace();
   if (!g["surfaces"]) r.fail(g, "contact.ground", "missing key 'surfaces'");
-  scene.ground.surfaces = r.texts(g["surfaces"], "contact.ground.surfaces");
-  if (g["point"]) scene.ground.point = r.vector3(g["point"], "contact.ground.point");
+  ground.surfaces = r.texts(g["surfaces"], "contact.ground.surfaces");
+  if (g["point"]) ground.point = r.vector3(g["point"], "contact.ground.point");
   if (g["normal"]) {
-    scene.ground.normal = r.vector3(g["normal"], "contact.ground.normal");
-    if (scene.ground.normal.norm() == 0) r.fail(g["normal"], "contact.ground.normal", "must not be zero");
+    ground.normal = r.vector3(g["normal"], "contact.ground.normal");
+    if (ground.normal.norm() == 0) r.fail(g["normal"], "contact.ground.normal", "must not be zero");
   }
-  if (g["dhat"]) scene.ground.dhat = r.number(g["dhat"], "contact.ground.dhat");
-  if (g["kappa"]) scene.ground.kappa = r.number(g["kappa"], "contact.ground.kappa");
+  r.optional(g, "contact.ground", "dhat", ground.dhat);
+  r.optional(g, "contact.ground", "kappa", ground.kappa);
 }
 
 FrictionRegion read_friction_region(const SceneReader& r, const YAML::Node& reg, double end) {
@@ -41,21 +41,19 @@ FrictionRegion read_friction_region(const SceneReader& r, const YAML::Node& reg,
 
 void read_friction(const SceneReader& r, const YAML::Node& f, Scene& scene) {
   r.allow(f, "contact.friction");
-  if (!scene.ground_contact) r.fail(f, "contact.friction", "friction needs contact.ground");
-  scene.friction = true;
-  r.optional(f, "contact.friction", "eps_v", scene.friction_spec.eps_v);
-  r.optional(f, "contact.friction", "lag_updates", scene.friction_spec.lag_updates);
+  if (!scene.ground) r.fail(f, "contact.friction", "friction needs contact.ground");
+  FrictionSpec& friction = scene.friction.emplace();
+  r.optional(f, "contact.friction", "eps_v", friction.eps_v);
+  r.optional(f, "contact.friction", "lag_updates", friction.lag_updates);
   if (!f["regions"] || !f["regions"].IsSequence())
     r.fail(f, "contact.friction", "missing 'regions: [{surface, mu_static, mu_kinetic}, ...]'");
-  for (const auto& reg : f["regions"])
-    scene.friction_spec.regions.push_back(read_friction_region(r, reg, scene.solver.t_end));
+  for (const auto& reg : f["regions"]) friction.regions.push_back(read_friction_region(r, reg, scene.solver.t_end));
 }
 
 void read_lattice_floor(const SceneReader& r, const YAML::Node& lf, Scene& scene) {
   const std::string key = "contact.lattice_floor";
   r.allow(lf, key);
-  scene.lattice_floor = true;
-  LatticeFloorScene& spec = scene.lattice_floor_spec;
+  LatticeFloorScene& spec = scene.lattice_floor.emplace();
   r.optional(lf, key, "gap_foot_columns", spec.gap_foot_columns);
   if (lf["point"]) spec.floor.point = r.vector3(lf["point"], key + ".point");
   if (lf["normal"]) {
@@ -77,11 +75,10 @@ void read_lattice_floor(const SceneReader& r, const YAML::Node& lf, Scene& scene
 }
 
 void read_self_contact(const SceneReader& r, const YAML::Node& sc, Scene& scene) {
-  SelfContactSpec& spec = scene.self_contact_spec;
   r.allow(sc, "contact.self");
+  SelfContactSpec& spec = scene.self_contact.emplace();
   r.optional(sc, "contact.self", "start", spec.start);
   r.optional(sc, "contact.self", "project_hessian", spec.project_hessian);
-  scene.self_contact = true;
   const YAML::Node pairs = sc["pairs"];
   if (!pairs || !pairs.IsSequence() || pairs.size() == 0)
     r.fail(pairs ? pairs : sc, "contact.self.pairs", "expected a list of surface pairs [[surf_a, surf_b], ...]");
@@ -103,7 +100,7 @@ void read_self_contact(const SceneReader& r, const YAML::Node& sc, Scene& scene)
 void read_dynamics(const SceneReader& r, const YAML::Node& d, Scene& scene) {
   if (!d) return;
   r.allow(d, "dynamics");
-  scene.dynamic = true;
+  DynamicsSpec& dynamics = scene.dynamics.emplace();
   if (d["scheme"]) {
     const std::string name = r.text(d["scheme"], "dynamics.scheme");
     const auto it = time_schemes().find(name);
@@ -111,17 +108,17 @@ void read_dynamics(const SceneReader& r, const YAML::Node& d, Scene& scene) {
       r.fail(d["scheme"], "dynamics.scheme",
              "unknown scheme '" + name + "' (known: " + join_keys(time_schemes(), ", ") + ")");
     }
-    scene.inertia.scheme = it->second;
+    dynamics.inertia.scheme = it->second;
   }
   auto flag = [&](const char* key, bool& out) {
     if (d[key]) out = r.number(d[key], std::string("dynamics.") + key) != 0;
   };
-  flag("lumped", scene.inertia.lumped);
-  flag("adaptive", scene.inertia.adaptive);
-  r.optional(d, "dynamics", "error_tolerance", scene.inertia.error_tolerance);
-  r.optional(d, "dynamics", "shear_viscosity", scene.shear_viscosity);
-  r.optional(d, "dynamics", "bulk_viscosity", scene.bulk_viscosity);
-  if (d["initial_velocity"]) scene.initial_velocity = r.vector3(d["initial_velocity"], "dynamics.initial_velocity");
+  flag("lumped", dynamics.inertia.lumped);
+  flag("adaptive", dynamics.inertia.adaptive);
+  r.optional(d, "dynamics", "error_tolerance", dynamics.inertia.error_tolerance);
+  r.optional(d, "dynamics", "shear_viscosity", dynamics.shear_viscosity);
+  r.optional(d, "dynamics", "bulk_viscosity", dynamics.bulk_viscosity);
+  if (d["initial_velocity"]) dynamics.initial_velocity = r.vector3(d["initial_velocity"], "dynamics.initial_velocity");
 }
 
 void read_contact(const SceneReader& r, const YAML::Node& c, Scene& scene) {
