@@ -358,18 +358,15 @@ std::string KeyRange::text() const {
 }
 
 std::string SceneKey::requirement() const {
-  std::string what;
+  const bool bounded = range && range->lo > -kInf && range->hi < kInf;  // "in [lo, hi]", else "> lo" or "<= hi"
+  const std::string bound = range ? (bounded ? "in " : "") + range->text() : "";
   if (type == KeyType::integer) {
-    what = range && range->lo == 1 && !range->lo_open && range->hi == kInf
-               ? "must be a positive integer"
-               : "must be an integer " + (range ? (range->hi == kInf ? range->text() : "in " + range->text()) : "");
-    return what;
+    if (range && range->lo == 1 && !range->lo_open && range->hi == kInf) return "must be a positive integer";
+    return range ? "must be an integer " + bound : "must be an integer";
   }
   if (!range) return "";
-  if (range->lo == 0 && range->hi == kInf)
-    what = range->lo_open ? "must be positive" : "must not be negative";
-  else
-    what = "must be " + std::string(range->hi == kInf || range->lo == -kInf ? "" : "in ") + range->text();
+  std::string what = "must be " + bound;
+  if (range->lo == 0 && range->hi == kInf) what = range->lo_open ? "must be positive" : "must not be negative";
   if (!unit.empty() && unit != "[-]") what += " " + unit;
   return what;
 }

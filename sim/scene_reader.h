@@ -9,6 +9,7 @@
 #include <cmath>
 #include <filesystem>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
@@ -146,7 +147,9 @@ struct SceneReader {
   // One of the values the table lists for `key`.
   std::string choice(const YAML::Node& node, const std::string& key) const {
     const std::string value = text(node, key);
-    const std::vector<std::string>& allowed = find_scene_key(key)->choices;
+    const SceneKey* declared = find_scene_key(key);
+    if (!declared) throw std::logic_error("scene key '" + key + "' is not declared (sim/scene_keys.cpp)");
+    const std::vector<std::string>& allowed = declared->choices;
     if (std::find(allowed.begin(), allowed.end(), value) == allowed.end())
       fail(node, key, "must be one of '" + join(allowed, "', '") + "'");
     return value;
