@@ -3,12 +3,16 @@
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
+#include <cmath>
 #include <fstream>
+#include <functional>
+#include <map>
 #include <set>
 #include <sstream>
 #include <string>
 
 #include "core/errors.h"
+#include "fem/inertia.h"
 #include "sim/scene.h"
 #include "sim/scene_keys.h"
 
@@ -118,4 +122,120 @@ TEST(SceneKeys, SolverKeysReachTheSolverOptions) {
   EXPECT_FALSE(scene.solver.extrapolate);
   const std::string e = error_of("solver: {extrapolate: 0}");
   EXPECT_NE(e.find("'solver.extrapolate': expected true or false, got '0'"), std::string::npos) << e;
+}
+
+// Every documented default that is a number, true/false or one of the key's choices is
+// what the readers leave in the scene when the key is absent: a scene with each section
+// present but (nearly) empty reads to the table's defaults.
+TEST(SceneKeys, DocumentedDefaultsAreTheReadersDefaults) {
+  const std::string schedule = std::string(MORPHFEM_SOURCE_DIR) + "/examples/schedules/rolling.yaml";
+  const Scene quiet = read(R"(loads:
+  gas_cavities: [{surfaces: [zmax]}]
+  volume_cavities: [{surfaces: [zmax], volume_ratio: [[0, 1], [1, 2]], penalty_modulus: 1.0e5}]
+  pulls: [{surface: xmax, stiffness: 1, velocity: [1, 0, 0]}]
+contact:
+  ground: {surfaces: zmin}
+  friction: {regions: []}
+  lattice_floor: {kappa: 1, mu: {body: 1}}
+  self: {pairs: [[zmax, zmax]]}
+actuation: {schedule: )" + schedule +
+                           R"(, bladders: {b1: zmax}, feet: {foot_a: zmin}, valves: {fill_time_s: 1}}
+environment: {}
+output: {})");
+  const Scene dynamic = read("dynamics: {}");  // friction would need implicit Euler
+  auto foot_mu = [&](bool active) {
+    double mu = active ? 0 : 1e300;
+    for (double t = 0; t < 30; t += 0.01) {
+      const double m = quiet.friction->regions.at(0).mu_static(t);
+      mu = active ? std::max(mu, m) : std::min(mu, m);
+    }
+    return mu;
+  };
+  auto scheme = [&] {
+    for (const auto& [name, s] : time_schemes())
+      if (s == dynamic.dynamics->inertia.scheme) return name;
+    return std::string("?");
+  };
+  const Eigen::Vector3d g = quiet.gravity;
+  using Value = std::function<double()>;
+  const std::map<std::string, Value> numbers = {
+      {"loads.gas_cavities.symmetry_factor", [&] { return quiet.gas_cavities.at(0).wall.symmetry_factor; }},
+      {"loads.gas_cavities.temperature", [&] { return quiet.gas_cavities.at(0).temperature; }},
+      {"loads.gas_cavities.initial_gauge_pressure", [&] { return quiet.gas_cavities.at(0).initial_gauge_pressure; }},
+      {"loads.gas_cavities.supply_pressure", [&] { return quiet.gas_cavities.at(0).supply_gauge_pressure(0.5); }},
+      {"loads.gas_cavities.conductance", [&] { return quiet.gas_cavities.at(0).conductance(0.5); }},
+      {"loads.volume_cavities.tolerance", [&] { return quiet.volume_cavities.at(0).tolerance; }},
+      {"loads.pulls.start", [&] { return quiet.pulls.at(0).start; }},
+      {"solver.end_time", [&] { return quiet.solver.t_end; }},
+      {"solver.initial_step", [&] { return quiet.solver.dt_initial; }},
+      {"solver.min_step", [&] { return quiet.solver.dt_min; }},
+      {"solver.max_step", [&] { return quiet.solver.dt_max; }},
+      {"solver.rtol", [&] { return quiet.solver.rtol; }},
+      {"solver.newton_velocity_tol", [&] { return quiet.solver.newton_velocity_tol; }},
+      {"solver.quadrature_degree", [&] { return quiet.quadrature_degree; }},
+      {"solver.max_newton_its", [&] { return quiet.solver.max_newton_its; }},
+      {"solver.easy_newton_its", [&] { return quiet.solver.easy_newton_its; }},
+      {"output.every", [&] { return quiet.output_every; }},
+      {"output.checkpoint_s", [&] { return quiet.checkpoint_s; }},
+      {"dynamics.lumped", [&] { return dynamic.dynamics->inertia.lumped; }},
+      {"dynamics.adaptive", [&] { return dynamic.dynamics->inertia.adaptive; }},
+      {"dynamics.error_tolerance", [&] { return dynamic.dynamics->inertia.error_tolerance; }},
+      {"dynamics.shear_viscosity", [&] { return dynamic.dynamics->shear_viscosity; }},
+      {"dynamics.bulk_viscosity", [&] { return dynamic.dynamics->bulk_viscosity; }},
+      {"contact.ground.dhat", [&] { return quiet.ground->dhat; }},
+      {"contact.ground.kappa", [&] { return quiet.ground->kappa; }},
+      {"contact.friction.eps_v", [&] { return quiet.friction->eps_v; }},
+      {"contact.friction.lag_updates", [&] { return quiet.friction->lag_updates; }},
+      {"contact.lattice_floor.dhat", [&] { return quiet.lattice_floor->floor.dhat; }},
+      {"contact.lattice_floor.eps_v", [&] { return quiet.lattice_floor->floor.eps_v; }},
+      {"contact.lattice_floor.voxel_size", [&] { return quiet.lattice_floor->voxel_size; }},
+      {"contact.lattice_floor.gap_foot_columns", [&] { return quiet.lattice_floor->gap_foot_columns; }},
+      {"contact.self.dhat", [&] { return quiet.self_contact->dhat; }},
+      {"contact.self.kappa", [&] { return quiet.self_contact->kappa; }},
+      {"contact.self.inflation", [&] { return quiet.self_contact->inflation; }},
+      {"contact.self.max_trust_radius", [&] { return quiet.self_contact->max_trust_radius; }},
+      {"contact.self.project_hessian", [&] { return quiet.self_contact->project_hessian; }},
+      {"actuation.start", [&] { return quiet.gait.start; }},
+      {"actuation.feet.mu_active", [&] { return foot_mu(true); }},
+      {"actuation.feet.mu_inactive", [&] { return foot_mu(false); }},
+      {"actuation.valves.temperature", [&] { return quiet.gas_cavities.back().temperature; }},
+      {"actuation.weightless_inflated", [&] { return quiet.weightless_inflated; }},
+      {"environment.slope_deg", [&] { return std::atan2(std::hypot(g.x(), g.y()), -g.z()) * 180 / M_PI; }},
+      {"environment.gravity", [&] { return g.norm(); }},
+      {"solver.extrapolate", [&] { return quiet.solver.extrapolate; }},
+  };
+  const std::map<std::string, std::function<std::string()>> choices = {
+      {"solver.linear_solver", [&] { return quiet.solver.linear_solver; }},
+      {"solver.formulation", [&] { return quiet.formulation; }},
+      {"solver.hessian_projection",
+       [&] {
+         return std::string(quiet.solver.hessian_projection == HessianProjection::always ? "always" : "adaptive");
+       }},
+      {"dynamics.scheme", scheme},
+  };
+  int checked = 0;
+  for (const SceneKey& k : scene_keys()) {
+    size_t used = 0;
+    double fallback = 0;
+    try {
+      fallback = std::stod(k.fallback, &used);
+    } catch (const std::exception&) {
+    }
+    if (k.fallback == "true" || k.fallback == "false") {
+      fallback = k.fallback == "true";
+      used = k.fallback.size();
+    }
+    if (!k.fallback.empty() && used == k.fallback.size()) {
+      const auto value = numbers.find(k.path);
+      ASSERT_NE(value, numbers.end()) << k.path << ": add its value to this test";
+      EXPECT_NEAR(value->second(), fallback, 1e-12 * std::abs(fallback)) << k.path;
+      ++checked;
+    } else if (std::find(k.choices.begin(), k.choices.end(), k.fallback) != k.choices.end()) {
+      const auto value = choices.find(k.path);
+      ASSERT_NE(value, choices.end()) << k.path << ": add its value to this test";
+      EXPECT_EQ(value->second(), k.fallback) << k.path;
+      ++checked;
+    }
+  }
+  EXPECT_EQ(checked, int(numbers.size() + choices.size()));
 }
