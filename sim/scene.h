@@ -146,7 +146,6 @@ struct TractionSpec {
   std::string where;
 };
 
-// The gait measurement of a scene that plays a schedule (see `environment`).
 // contact.lattice_floor: the voxel lattice's floor contact on a robot_voxel body, a
 // sphere at each lattice voxel's centre (contact/lattice_floor.h; a diagnostic).
 struct LatticeFloorScene {
@@ -171,6 +170,7 @@ struct DynamicsSpec {
   Eigen::Vector3d initial_velocity = Eigen::Vector3d::Zero();  // [m/s]
 };
 
+// The gait measurement of a scene that plays a schedule (see `environment`).
 struct GaitSpec {
   bool enabled = false;
   double start = 0.0, end = 0.0;  // simulation times of the gait's first column and its end [s]
