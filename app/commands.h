@@ -16,6 +16,7 @@ int fit_materials_command(const std::vector<std::string>& args);
 int robot_command(const std::vector<std::string>& args, MPI_Comm comm);
 int search_command(const std::vector<std::string>& args, MPI_Comm comm);
 int calibrate_command(const std::vector<std::string>& args, MPI_Comm comm);
+int scene_keys_command(const std::vector<std::string>& args);
 
 // A subcommand's runner on `comm`, as core/command_line.h's Subcommand takes it.
 inline std::function<int(const std::vector<std::string>&)> on_comm(int (*run)(const std::vector<std::string>&,

@@ -36,6 +36,7 @@ const std::vector<Command>& commands() {
       {"robot", "the robot's gaits: validate, ladder, spread, morph, friction, benchmark", {}, morphfem::robot_command},
       {"search", "hill climbing / CMA-ES over shape, orientation and schedule", {}, morphfem::search_command},
       {"calibrate", "friction, material and morphing calibration from measurements", {}, morphfem::calibrate_command},
+      {"scene-keys", "every scene key's type, unit, default and range", morphfem::scene_keys_command, {}},
       {"hw", "play schedules on the pneumatic regulators (check, play, emulate)", morphfem::hardware_main, {}},
   };
   return table;

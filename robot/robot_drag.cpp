@@ -110,7 +110,7 @@ DragSetup drag_setup(const FrictionDragOptions& o) {
   for (const std::string& assignment : o.set) set_scene_key(d.doc, assignment, d.path);
   d.parsed = scene_from_yaml(d.doc, d.path);
   if (d.parsed.pulls.empty()) throw InputError(d.path, "friction-drag needs a test machine: loads.pulls");
-  if (!d.parsed.dynamic)
+  if (!d.parsed.dynamics)
     throw InputError(d.path, "friction-drag needs inertia (dynamics): slip after the peak is dynamic");
   const PullSpringSpec& pull = d.parsed.pulls.front();
   d.speed = pull.velocity.norm();

@@ -34,21 +34,19 @@ Scene drag_scene(const DragParameters& p) {
   material.set("density", p.weight_N / (g * volume));  // rho g V = W
   s.materials["body"] = material;
   s.gravity = Eigen::Vector3d(0, 0, -g);
-  s.dynamic = true;
-  s.inertia.scheme = TimeScheme::implicit_euler;
-  s.ground_contact = true;
-  s.ground.surfaces = {"zmin"};
+  s.dynamics.emplace().inertia.scheme = TimeScheme::implicit_euler;
+  GroundContactSpec& ground = s.ground.emplace();
+  ground.surfaces = {"zmin"};
   const double dhat = 1e-5;
-  s.ground.dhat = dhat;
+  ground.dhat = dhat;
   // Start at the resting barrier gap under the weight: d ~ dhat (1 - sqrt(p / (3 kappa))),
   // kappa = E ~ 3 mu, contact pressure W / A.
   const double pressure = p.weight_N / (p.block_length * p.block_width);
   const double resting = 1.0 - std::sqrt(pressure / (3.0 * 3.0 * p.shear_modulus));
-  s.ground.point = Eigen::Vector3d(0, 0, -resting * dhat);
-  s.friction = true;
-  s.friction_spec.eps_v = p.eps_v;
-  s.friction_spec.regions.push_back(
-      {"zmin", TimeFunction::constant(p.mu_static), TimeFunction::constant(p.mu_kinetic)});
+  ground.point = Eigen::Vector3d(0, 0, -resting * dhat);
+  FrictionSpec& friction = s.friction.emplace();
+  friction.eps_v = p.eps_v;
+  friction.regions.push_back({"zmin", TimeFunction::constant(p.mu_static), TimeFunction::constant(p.mu_kinetic)});
   PullSpringSpec pull;
   pull.surface = "xmax";
   pull.stiffness = p.stiffness;

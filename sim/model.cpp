@@ -89,7 +89,7 @@ std::vector<DirichletCondition> boundary_conditions(const Scene& scene, const Me
 // A dynamic scene's inertia starts at the scene's initial velocity.
 void start_inertia(Model& model) {
   if (!model.inertia) return;
-  const Eigen::Vector3d v0 = model.scene.initial_velocity;
+  const Eigen::Vector3d v0 = model.scene.dynamics->initial_velocity;  // inertia only with dynamics
   model.inertia->set_initial_velocity([v0](const Eigen::Vector3d&) { return v0; });
   model.inertia->initialize(*model.assembler, model.solver->solution(), 0.0);
 }
@@ -134,14 +134,14 @@ Mesh build_scene_mesh(const Scene& scene, MPI_Comm comm) {
     for (const auto& s : c.wall.surfaces) require_surface(scene, mesh, s, "", "loads.gas_cavities." + c.wall.name);
   for (const auto& c : scene.volume_cavities)
     for (const auto& s : c.wall.surfaces) require_surface(scene, mesh, s, "", "loads.volume_cavities." + c.wall.name);
-  if (scene.ground_contact)
-    for (const auto& surface : scene.ground.surfaces)
+  if (scene.ground)
+    for (const auto& surface : scene.ground->surfaces)
       require_surface(scene, mesh, surface, "", "contact.ground.surfaces");
   if (scene.friction)
-    for (const auto& region : scene.friction_spec.regions)
+    for (const auto& region : scene.friction->regions)
       require_surface(scene, mesh, region.surface, "", "contact.friction.regions");
   if (scene.self_contact)
-    for (const auto& [first, second] : scene.self_contact_spec.pairs)
+    for (const auto& [first, second] : scene.self_contact->pairs)
       for (const auto& surface : {first, second}) require_surface(scene, mesh, surface, "", "contact.self.pairs");
   return mesh;
 }

@@ -2,7 +2,8 @@
 // build the same struct). A scene declares only the physics it needs; the
 // simulation builds only those energy terms.
 //
-// YAML layout (every key is checked; unknown keys are errors):
+// YAML layout (every key is declared in sim/scene_keys.h's table, printed as
+// docs/scene-keys.md; unknown keys and numbers outside their range are errors):
 //   name: demo
 //   geometry: {type: thick_cylinder, inner_radius: 0.01, ..., mesh_size: 0.002, order: 2}
 //   mesh: {file: body.msh}                      # instead of geometry
@@ -42,7 +43,9 @@
 //   solver: {end_time: 1, initial_step: 0.1, min_step: 1e-6, max_step: 1,
 //            linear_solver: mumps|gamg, quadrature_degree: 0, max_newton_its: 30,
 //            easy_newton_its: 6,   # a step that converged in at most this many iterations grows 1.5x
-//            formulation: displacement, hessian_projection: adaptive}
+//            formulation: displacement, hessian_projection: adaptive,
+//            newton_velocity_tol: 0,   # m/s; > 0: Newton also stops once no node moves faster
+//            extrapolate: true}        # Newton starts from the last step's velocity
 //            # hessian_projection: adaptive (default) = the exact Hessian after a full Newton
 //            # step, falling back to the projected one if it does not descend or the line
 //            # search fails along it; always = terms project their Hessians to PSD in every
@@ -143,7 +146,6 @@ struct TractionSpec {
   std::string where;
 };
 
-// The gait measurement of a scene that plays a schedule (see `environment`).
 // contact.lattice_floor: the voxel lattice's floor contact on a robot_voxel body, a
 // sphere at each lattice voxel's centre (contact/lattice_floor.h; a diagnostic).
 struct LatticeFloorScene {
@@ -161,6 +163,14 @@ struct LatticeFloorScene {
   std::optional<TimeFunction> gap_foot_mu;  // set by actuation.feet (voxel timing)
 };
 
+// dynamics: inertia and viscous damping (a scene without them is quasi-static).
+struct DynamicsSpec {
+  InertiaOptions inertia;                                      // time scheme, mass lumping, error control
+  double shear_viscosity = 0.0, bulk_viscosity = 0.0;          // [Pa s]
+  Eigen::Vector3d initial_velocity = Eigen::Vector3d::Zero();  // [m/s]
+};
+
+// The gait measurement of a scene that plays a schedule (see `environment`).
 struct GaitSpec {
   bool enabled = false;
   double start = 0.0, end = 0.0;  // simulation times of the gait's first column and its end [s]
@@ -187,20 +197,12 @@ struct Scene {
   // manufactured solution's load), integrated with `body_force_degree`.
   std::function<Eigen::Vector3d(const Eigen::Vector3d& X, double t)> body_force;
   int body_force_degree = 4;
-  // Dynamics (inertia, viscous damping) — only if the scene asks for it.
-  bool dynamic = false;
-  InertiaOptions inertia;
-  double shear_viscosity = 0.0, bulk_viscosity = 0.0;          // [Pa s]
-  Eigen::Vector3d initial_velocity = Eigen::Vector3d::Zero();  // [m/s]
-  // Ground contact and friction — only if declared.
-  bool ground_contact = false;
-  GroundContactSpec ground;
-  bool friction = false;
-  FrictionSpec friction_spec;
-  bool lattice_floor = false;  // the voxel lattice's floor contact (a diagnostic, contact/lattice_floor.h)
-  LatticeFloorScene lattice_floor_spec;
-  bool self_contact = false;  // self-contact between declared surface pairs
-  SelfContactSpec self_contact_spec;
+  // Each present only if the scene declares it (the simulation builds only those terms).
+  std::optional<DynamicsSpec> dynamics;  // inertia and viscous damping
+  std::optional<GroundContactSpec> ground;
+  std::optional<FrictionSpec> friction;            // on the ground contact
+  std::optional<LatticeFloorScene> lattice_floor;  // the voxel lattice's floor contact (a diagnostic)
+  std::optional<SelfContactSpec> self_contact;     // between declared surface pairs
   std::string schedule_file;  // the actuation schedule, if any (its loads are in cavities/friction)
   // Values taken from calibration files (core/calibration_file.h), recorded in summary.json.
   struct CalibrationUse {

@@ -58,13 +58,11 @@ struct ActuationReader {
 
 // The start, the timing and the gait they give.
 void ActuationReader::read_timing() {
-  start = a["start"] ? r.number(a["start"], key + ".start") : 0.0;
-  if (start < 0) r.fail(a["start"], key + ".start", "must be >= 0");
+  r.optional(a, key, "start", start);
   if (a["growth"] && a["bladders"]) r.fail(a["growth"], key + ".growth", "give either bladders or growth, not both");
   timing = a["growth"] ? "voxel" : "schedule";
   if (a["timing"]) {
-    timing = r.text(a["timing"], key + ".timing");
-    if (timing != "schedule" && timing != "voxel") r.fail(a["timing"], key + ".timing", "must be schedule or voxel");
+    timing = r.choice(a["timing"], key + ".timing");
     if (a["growth"] && timing != "voxel")
       r.fail(a["timing"], key + ".timing", "growth actuation runs on the voxel timing");
   }
@@ -107,13 +105,13 @@ void ActuationReader::read_valves() {
   if (!valves) return;
   const std::string vkey = key + ".valves";
   if (!v.IsMap()) r.fail(v, vkey, "expected a map {fill_time_s: T} or {conductance: C}");
-  r.allow(v, vkey, {"fill_time_s", "conductance", "temperature"});
+  r.allow(v, vkey);
   if (static_cast<bool>(v["fill_time_s"]) == static_cast<bool>(v["conductance"]))
     r.fail(v, vkey, "give exactly one of fill_time_s [s] and conductance [mol/(s Pa)]");
-  auto positive = [&](const char *k) { return r.positive(v[k], vkey + "." + k, true); };
-  if (v["fill_time_s"]) valve.fill_time = positive("fill_time_s");
-  if (v["conductance"]) valve.conductance = TimeFunction::constant(positive("conductance"));
-  if (v["temperature"]) valve.temperature = positive("temperature");
+  auto calibrated = [&](const char *k) { return r.calibrated_number(v[k], vkey + "." + k); };
+  if (v["fill_time_s"]) valve.fill_time = calibrated("fill_time_s");
+  if (v["conductance"]) valve.conductance = TimeFunction::constant(calibrated("conductance"));
+  if (v["temperature"]) valve.temperature = calibrated("temperature");
 }
 
 // A channel's cavity; with actuation.<open_key> an open sleeve along that axis
@@ -177,13 +175,13 @@ void ActuationReader::read_core() {
 void ActuationReader::read_feet() {
   const auto f = a["feet"];
   if (!f) return;
-  r.allow(f, key + ".feet", {"foot_a", "foot_b", "mu_active", "mu_inactive"});
-  if (!scene.ground_contact && !scene.lattice_floor)
+  r.allow(f, key + ".feet");
+  if (!scene.ground && !scene.lattice_floor)
     r.fail(f, key + ".feet", "foot friction needs contact.ground (or contact.lattice_floor)");
   const double mu_active = f["mu_active"] ? r.calibrated_number(f["mu_active"], key + ".feet.mu_active") : 2.0;
   const double mu_inactive = f["mu_inactive"] ? r.calibrated_number(f["mu_inactive"], key + ".feet.mu_inactive") : 1e-4;
   // Ground contact: friction regions; the lattice floor only: its foot voxels.
-  scene.friction = scene.ground_contact;
+  if (scene.ground && !scene.friction) scene.friction.emplace();
   for (const auto &[foot, channel] :
        {std::pair<const char *, int>{"foot_a", kChannelFootA}, {"foot_b", kChannelFootB}}) {
     if (!f[foot]) continue;
@@ -191,13 +189,13 @@ void ActuationReader::read_feet() {
                                 ? voxel_foot_friction(schedule, channel, start, mu_active, mu_inactive, voxel)
                                 : foot_friction(schedule, channel, start, mu_active, mu_inactive);
     const std::string surface = r.text(f[foot], key + ".feet." + foot);
-    if (scene.ground_contact)
-      scene.friction_spec.regions.push_back({surface, mu, mu});
+    if (scene.ground)
+      scene.friction->regions.push_back({surface, mu, mu});
     else
-      scene.lattice_floor_spec.feet.push_back({surface, mu});
+      scene.lattice_floor->feet.push_back({surface, mu});
   }
-  LatticeFloorScene &lattice = scene.lattice_floor_spec;
-  if (lattice.gap_foot_columns && !scene.ground_contact) {
+  if (scene.lattice_floor && scene.lattice_floor->gap_foot_columns && !scene.ground) {
+    LatticeFloorScene &lattice = *scene.lattice_floor;
     if (timing != "voxel")
       r.fail(f, key + ".feet", "contact.lattice_floor.gap_foot_columns needs the voxel timing (growth actuation)");
     lattice.gap_foot_mu = voxel_gap_foot_friction(schedule, start, mu_active, mu_inactive, voxel);
@@ -208,9 +206,7 @@ void ActuationReader::read_feet() {
 
 std::optional<Schedule> read_actuation(const SceneReader &r, const YAML::Node &a, Scene &scene) {
   if (!a) return std::nullopt;
-  r.allow(a, "actuation",
-          {"schedule", "start", "bladders", "growth", "timing", "core", "core_ramp_s", "volume_axes", "core_open_axis",
-           "bladders_open_axis", "feet", "weightless_inflated", "valves"});
+  r.allow(a, "actuation");
   std::optional<Schedule> schedule = read_schedule_key(r, a, scene);
   ActuationReader actuation(r, a, scene, *schedule);
   actuation.read_timing();
@@ -229,24 +225,21 @@ void read_environment(const SceneReader &r, const YAML::Node &root, const std::o
   const auto e = root["environment"];
   if (!e) return;
   const std::string key = "environment";
-  r.allow(e, key, {"slope_deg", "heading_deg", "gravity", "body_length"});
+  r.allow(e, key);
   if (root["loads"] && root["loads"]["gravity"])
     r.fail(e, key, "give gravity either in loads.gravity or through environment, not both");
-  const double slope = e["slope_deg"] ? r.number(e["slope_deg"], key + ".slope_deg") : 0.0;
-  if (slope < -90 || slope > 90) r.fail(e["slope_deg"], key + ".slope_deg", "must be in [-90, 90]");
+  double slope = 0.0;
+  r.optional(e, key, "slope_deg", slope);
   double heading = schedule ? schedule->orientation_deg : 0.0;
-  if (e["heading_deg"]) heading = r.number(e["heading_deg"], key + ".heading_deg");
-  const double g = e["gravity"] ? r.number(e["gravity"], key + ".gravity") : 9.80665;
-  if (!(g >= 0)) r.fail(e["gravity"], key + ".gravity", "must be >= 0 [m/s^2]");
+  r.optional(e, key, "heading_deg", heading);
+  double g = 9.80665;
+  r.optional(e, key, "gravity", g);
   const double deg = M_PI / 180.0, s_ = slope * deg, h = heading * deg;
   // The voxel study's rotated gravity: uphill along the heading (cos h, sin h,
   // 0).
   scene.gravity = g * Eigen::Vector3d(-std::sin(s_) * std::cos(h), -std::sin(s_) * std::sin(h), -std::cos(s_));
   scene.gait.heading = Eigen::Vector3d(std::cos(h), std::sin(h), 0.0);
-  if (e["body_length"]) {
-    scene.gait.body_length = r.number(e["body_length"], key + ".body_length");
-    if (!(scene.gait.body_length > 0)) r.fail(e["body_length"], key + ".body_length", "must be positive [m]");
-  }
+  r.optional(e, key, "body_length", scene.gait.body_length);
 }
 
 }  // namespace morphfem

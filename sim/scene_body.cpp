@@ -12,7 +12,7 @@ void read_geometry(const SceneReader& r, const YAML::Node& root, Scene& scene) {
     scene.geometry = r.params(g, "geometry");
     if (!scene.geometry.has("type")) r.fail(g, "geometry", "missing key 'type'");
   } else if (const auto m = root["mesh"]) {
-    r.allow(m, "mesh", {"file"});
+    r.allow(m, "mesh");
     if (!m["file"]) r.fail(m, "mesh", "missing key 'file'");
     std::filesystem::path file = r.text(m["file"], "mesh.file");
     if (file.is_relative()) file = std::filesystem::path(r.file).parent_path() / file;
@@ -46,7 +46,8 @@ void read_membranes(const SceneReader& r, const YAML::Node& membranes, Scene& sc
     if (!p.has("thickness")) r.fail(kv.second, key, "missing key 'thickness' [m]");
     MembraneSpec spec;
     spec.surface = surface;
-    spec.thickness = p.number_in("thickness", 1e-9, 1.0);
+    const KeyRange& thickness = *find_scene_key(key + ".thickness")->range;
+    spec.thickness = p.number_in("thickness", thickness.lo, thickness.hi);
     spec.law = make_membrane_law(p.without("thickness"));
     spec.where = p.where("model");
     scene.membranes.push_back(spec);
@@ -57,7 +58,7 @@ void read_boundary(const SceneReader& r, const YAML::Node& b, Scene& scene) {
   if (!b) return;
   if (!b.IsSequence()) r.fail(b, "boundary", "expected a list of {surface, fix | displacement}");
   for (const auto& item : b) {
-    r.allow(item, "boundary", {"surface", "fix", "displacement"});
+    r.allow(item, "boundary");
     if (!item["surface"]) r.fail(item, "boundary", "missing key 'surface'");
     BoundarySpec spec;
     spec.surface = r.text(item["surface"], "boundary.surface");

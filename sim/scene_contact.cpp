@@ -7,21 +7,21 @@ namespace morphfem {
 namespace {
 
 void read_ground(const SceneReader& r, const YAML::Node& g, Scene& scene) {
-  r.allow(g, "contact.ground", {"point", "normal", "surfaces", "dhat", "kappa"});
-  scene.ground_contact = true;
+  r.allow(g, "contact.ground");
+  GroundContactSpec& ground = scene.ground.emplace();
   if (!g["surfaces"]) r.fail(g, "contact.ground", "missing key 'surfaces'");
-  scene.ground.surfaces = r.texts(g["surfaces"], "contact.ground.surfaces");
-  if (g["point"]) scene.ground.point = r.vector3(g["point"], "contact.ground.point");
+  ground.surfaces = r.texts(g["surfaces"], "contact.ground.surfaces");
+  if (g["point"]) ground.point = r.vector3(g["point"], "contact.ground.point");
   if (g["normal"]) {
-    scene.ground.normal = r.vector3(g["normal"], "contact.ground.normal");
-    if (scene.ground.normal.norm() == 0) r.fail(g["normal"], "contact.ground.normal", "must not be zero");
+    ground.normal = r.vector3(g["normal"], "contact.ground.normal");
+    if (ground.normal.norm() == 0) r.fail(g["normal"], "contact.ground.normal", "must not be zero");
   }
-  if (g["dhat"]) scene.ground.dhat = r.number(g["dhat"], "contact.ground.dhat");
-  if (g["kappa"]) scene.ground.kappa = r.number(g["kappa"], "contact.ground.kappa");
+  r.optional(g, "contact.ground", "dhat", ground.dhat);
+  r.optional(g, "contact.ground", "kappa", ground.kappa);
 }
 
 FrictionRegion read_friction_region(const SceneReader& r, const YAML::Node& reg, double end) {
-  r.allow(reg, "contact.friction.regions", {"surface", "mu_static", "mu_kinetic", "mu"});
+  r.allow(reg, "contact.friction.regions");
   FrictionRegion region;
   if (!reg["surface"]) r.fail(reg, "contact.friction.regions", "missing key 'surface'");
   region.surface = r.text(reg["surface"], "contact.friction.regions.surface");
@@ -40,24 +40,21 @@ FrictionRegion read_friction_region(const SceneReader& r, const YAML::Node& reg,
 }
 
 void read_friction(const SceneReader& r, const YAML::Node& f, Scene& scene) {
-  r.allow(f, "contact.friction", {"eps_v", "lag_updates", "regions"});
-  if (!scene.ground_contact) r.fail(f, "contact.friction", "friction needs contact.ground");
-  scene.friction = true;
-  r.optional_positive(f, "contact.friction", "eps_v", scene.friction_spec.eps_v);
-  if (f["lag_updates"])
-    scene.friction_spec.lag_updates = int(r.number(f["lag_updates"], "contact.friction.lag_updates"));
+  r.allow(f, "contact.friction");
+  if (!scene.ground) r.fail(f, "contact.friction", "friction needs contact.ground");
+  FrictionSpec& friction = scene.friction.emplace();
+  r.optional(f, "contact.friction", "eps_v", friction.eps_v);
+  r.optional(f, "contact.friction", "lag_updates", friction.lag_updates);
   if (!f["regions"] || !f["regions"].IsSequence())
     r.fail(f, "contact.friction", "missing 'regions: [{surface, mu_static, mu_kinetic}, ...]'");
-  for (const auto& reg : f["regions"])
-    scene.friction_spec.regions.push_back(read_friction_region(r, reg, scene.solver.t_end));
+  for (const auto& reg : f["regions"]) friction.regions.push_back(read_friction_region(r, reg, scene.solver.t_end));
 }
 
 void read_lattice_floor(const SceneReader& r, const YAML::Node& lf, Scene& scene) {
   const std::string key = "contact.lattice_floor";
-  r.allow(lf, key, {"point", "normal", "dhat", "kappa", "eps_v", "voxel_size", "mu", "gap_foot_columns"});
-  scene.lattice_floor = true;
-  LatticeFloorScene& spec = scene.lattice_floor_spec;
-  if (lf["gap_foot_columns"]) spec.gap_foot_columns = r.flag(lf["gap_foot_columns"], key + ".gap_foot_columns");
+  r.allow(lf, key);
+  LatticeFloorScene& spec = scene.lattice_floor.emplace();
+  r.optional(lf, key, "gap_foot_columns", spec.gap_foot_columns);
   if (lf["point"]) spec.floor.point = r.vector3(lf["point"], key + ".point");
   if (lf["normal"]) {
     spec.floor.normal = r.vector3(lf["normal"], key + ".normal");
@@ -65,26 +62,23 @@ void read_lattice_floor(const SceneReader& r, const YAML::Node& lf, Scene& scene
   }
   for (auto [k, value] : {std::pair{"dhat", &spec.floor.dhat}, std::pair{"eps_v", &spec.floor.eps_v},
                           std::pair{"voxel_size", &spec.voxel_size}})
-    r.optional_positive(lf, key, k, *value);
+    r.optional(lf, key, k, *value);
   if (!lf["kappa"]) r.fail(lf, key, "missing key 'kappa' (the barrier stiffness [Pa])");
-  r.optional_positive(lf, key, "kappa", spec.floor.kappa);
+  r.optional(lf, key, "kappa", spec.floor.kappa);
   const YAML::Node mu = lf["mu"];
   if (!mu || !mu.IsMap() || mu.size() == 0)
     r.fail(mu ? mu : lf, key + ".mu", "expected a map volume region -> friction coefficient, e.g. {skin: 2.0}");
   for (const auto& item : mu) {
     const std::string region = r.text(item.first, key + ".mu");
-    const double value = r.number(item.second, key + ".mu." + region);
-    if (!(value >= 0)) r.fail(item.second, key + ".mu." + region, "must not be negative");
-    spec.mu[region] = value;
+    spec.mu[region] = r.number(item.second, key + ".mu." + region);
   }
 }
 
 void read_self_contact(const SceneReader& r, const YAML::Node& sc, Scene& scene) {
-  SelfContactSpec& spec = scene.self_contact_spec;
-  r.allow(sc, "contact.self", {"pairs", "dhat", "kappa", "inflation", "max_trust_radius", "start", "project_hessian"});
-  if (sc["start"]) spec.start = r.number(sc["start"], "contact.self.start");
-  if (sc["project_hessian"]) spec.project_hessian = r.flag(sc["project_hessian"], "contact.self.project_hessian");
-  scene.self_contact = true;
+  r.allow(sc, "contact.self");
+  SelfContactSpec& spec = scene.self_contact.emplace();
+  r.optional(sc, "contact.self", "start", spec.start);
+  r.optional(sc, "contact.self", "project_hessian", spec.project_hessian);
   const YAML::Node pairs = sc["pairs"];
   if (!pairs || !pairs.IsSequence() || pairs.size() == 0)
     r.fail(pairs ? pairs : sc, "contact.self.pairs", "expected a list of surface pairs [[surf_a, surf_b], ...]");
@@ -97,20 +91,16 @@ void read_self_contact(const SceneReader& r, const YAML::Node& sc, Scene& scene)
   // the default.
   for (auto [key, value] :
        {std::pair{"dhat", &spec.dhat}, std::pair{"kappa", &spec.kappa}, std::pair{"inflation", &spec.inflation},
-        std::pair{"max_trust_radius", &spec.max_trust_radius}}) {
-    if (!sc[key]) continue;
-    *value = r.number(sc[key], std::string("contact.self.") + key);
-    if (!(*value >= 0)) r.fail(sc[key], std::string("contact.self.") + key, "must not be negative");
-  }
+        std::pair{"max_trust_radius", &spec.max_trust_radius}})
+    r.optional(sc, "contact.self", key, *value);
 }
 
 }  // namespace
 
 void read_dynamics(const SceneReader& r, const YAML::Node& d, Scene& scene) {
   if (!d) return;
-  r.allow(d, "dynamics",
-          {"scheme", "lumped", "adaptive", "error_tolerance", "shear_viscosity", "bulk_viscosity", "initial_velocity"});
-  scene.dynamic = true;
+  r.allow(d, "dynamics");
+  DynamicsSpec& dynamics = scene.dynamics.emplace();
   if (d["scheme"]) {
     const std::string name = r.text(d["scheme"], "dynamics.scheme");
     const auto it = time_schemes().find(name);
@@ -118,27 +108,22 @@ void read_dynamics(const SceneReader& r, const YAML::Node& d, Scene& scene) {
       r.fail(d["scheme"], "dynamics.scheme",
              "unknown scheme '" + name + "' (known: " + join_keys(time_schemes(), ", ") + ")");
     }
-    scene.inertia.scheme = it->second;
+    dynamics.inertia.scheme = it->second;
   }
   auto flag = [&](const char* key, bool& out) {
     if (d[key]) out = r.number(d[key], std::string("dynamics.") + key) != 0;
   };
-  flag("lumped", scene.inertia.lumped);
-  flag("adaptive", scene.inertia.adaptive);
-  auto nonnegative = [&](const char* key, double& out) {
-    if (!d[key]) return;
-    out = r.number(d[key], std::string("dynamics.") + key);
-    if (out < 0) r.fail(d[key], std::string("dynamics.") + key, "must not be negative");
-  };
-  nonnegative("error_tolerance", scene.inertia.error_tolerance);
-  nonnegative("shear_viscosity", scene.shear_viscosity);
-  nonnegative("bulk_viscosity", scene.bulk_viscosity);
-  if (d["initial_velocity"]) scene.initial_velocity = r.vector3(d["initial_velocity"], "dynamics.initial_velocity");
+  flag("lumped", dynamics.inertia.lumped);
+  flag("adaptive", dynamics.inertia.adaptive);
+  r.optional(d, "dynamics", "error_tolerance", dynamics.inertia.error_tolerance);
+  r.optional(d, "dynamics", "shear_viscosity", dynamics.shear_viscosity);
+  r.optional(d, "dynamics", "bulk_viscosity", dynamics.bulk_viscosity);
+  if (d["initial_velocity"]) dynamics.initial_velocity = r.vector3(d["initial_velocity"], "dynamics.initial_velocity");
 }
 
 void read_contact(const SceneReader& r, const YAML::Node& c, Scene& scene) {
   if (!c) return;
-  r.allow(c, "contact", {"ground", "friction", "self", "lattice_floor"});
+  r.allow(c, "contact");
   if (const auto g = c["ground"]) read_ground(r, g, scene);
   if (const auto f = c["friction"]) read_friction(r, f, scene);
   if (const auto lf = c["lattice_floor"]) read_lattice_floor(r, lf, scene);

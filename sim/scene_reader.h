@@ -4,10 +4,12 @@
 #pragma once
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <filesystem>
 #include <optional>
-#include <set>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
@@ -17,6 +19,7 @@
 #include "core/errors.h"
 #include "core/strings.h"
 #include "sim/scene.h"
+#include "sim/scene_keys.h"
 
 namespace morphfem {
 
@@ -33,28 +36,49 @@ struct SceneReader {
   [[noreturn]] void fail(const YAML::Node& node, const std::string& key, const std::string& what) const {
     throw InputError(at(node), (key.empty() ? "" : "'" + key + "': ") + what);
   }
-  void allow(const YAML::Node& map, const std::string& key, const std::set<std::string>& allowed) const {
+  // The mapping `map` at `key` holds only the keys the table declares under `section`
+  // (sim/scene_keys.h; `section` is `key` unless the mapping is a shared form, e.g. a
+  // calibrated value).
+  void allow(const YAML::Node& map, const std::string& key, const std::string& section) const {
     if (!map.IsMap()) fail(map, key, "expected a mapping of keys to values");
+    const std::vector<std::string> allowed = scene_key_children(section);
     for (const auto& kv : map) {
       const std::string k = kv.first.as<std::string>();
-      if (!allowed.count(k)) {
+      if (std::find(allowed.begin(), allowed.end(), k) == allowed.end()) {
         fail(kv.first, key.empty() ? k : key + "." + k, "unknown key (allowed: " + join(allowed, ", ") + ")");
       }
     }
   }
+  void allow(const YAML::Node& map, const std::string& key) const { allow(map, key, key); }
+  // The value `v` of `key` within the key's declared range (and whole if the key is an
+  // integer); keys of other types, or without a range, take any number.
+  void check_range(const YAML::Node& node, const std::string& key, double v) const {
+    const SceneKey* declared = find_scene_key(key);
+    if (!declared) return;
+    const KeyType type = declared->type;
+    if (type != KeyType::number && type != KeyType::integer && type != KeyType::calibrated) return;
+    const bool whole = type != KeyType::integer || v == std::floor(v);
+    if (!whole || (declared->range && !declared->range->contains(v))) fail(node, key, declared->requirement());
+  }
+  // A number, checked against the range the table declares for `key`.
   double number(const YAML::Node& node, const std::string& key) const {
     if (!node.IsScalar()) fail(node, key, "expected a number");
+    double v = 0;
     try {
-      return node.as<double>();
+      v = node.as<double>();
     } catch (const YAML::Exception&) {
       fail(node, key, "expected a number, got '" + node.Scalar() + "'");
     }
+    check_range(node, key, v);
+    return v;
   }
+  // An integer key (the table declares it whole, and its range).
+  int integer(const YAML::Node& node, const std::string& key) const { return int(number(node, key)); }
   // A number, or a value from a calibration file: {calibration: FILE, parameter: NAME}
   // (FILE relative to the scene). The use is recorded in the scene (summary.json).
   double calibrated_number(const YAML::Node& node, const std::string& key) const {
     if (!node.IsMap()) return number(node, key);
-    allow(node, key, {"calibration", "parameter"});
+    allow(node, key, "(calibrated value)");
     if (!node["calibration"] || !node["parameter"])
       fail(node, key, "a calibrated value needs {calibration: FILE, parameter: NAME}");
     std::filesystem::path path = text(node["calibration"], key + ".calibration");
@@ -68,20 +92,11 @@ struct SceneReader {
       fail(node["parameter"], key + ".parameter",
            "'" + path.string() + "' has no parameter '" + name +
                "' (it has: " + join_keys(calibration.parameters, ", ") + ")");
+    check_range(node, key, value->value);
     if (scene)
       scene->calibrations.push_back(
           {key, path.string(), sha256_file(path.string()), calibration.kind, name, value->value, value->std_error});
     return value->value;
-  }
-  // A number (or, if `calibrated`, a calibrated value) that must be > 0.
-  double positive(const YAML::Node& node, const std::string& key, bool calibrated = false) const {
-    const double v = calibrated ? calibrated_number(node, key) : number(node, key);
-    if (!(v > 0)) fail(node, key, "must be positive");
-    return v;
-  }
-  // The optional key map[k] (path where.k): a positive number into out, out untouched if absent.
-  void optional_positive(const YAML::Node& map, const std::string& where, const char* k, double& out) const {
-    if (map[k]) out = positive(map[k], where + "." + k);
   }
   Eigen::Vector3d vector3(const YAML::Node& node, const std::string& key) const {
     if (!node.IsSequence() || node.size() != 3) fail(node, key, "expected a list of 3 numbers [x, y, z]");
@@ -118,6 +133,26 @@ struct SceneReader {
     if (v == "true") return true;
     if (v == "false") return false;
     fail(node, key, "expected true or false, got '" + v + "'");
+  }
+  // The optional key map[k] (path section.k) into out, out untouched if absent.
+  void optional(const YAML::Node& map, const std::string& section, const char* k, double& out) const {
+    if (map[k]) out = number(map[k], section + "." + k);
+  }
+  void optional(const YAML::Node& map, const std::string& section, const char* k, int& out) const {
+    if (map[k]) out = integer(map[k], section + "." + k);
+  }
+  void optional(const YAML::Node& map, const std::string& section, const char* k, bool& out) const {
+    if (map[k]) out = flag(map[k], section + "." + k);
+  }
+  // One of the values the table lists for `key`.
+  std::string choice(const YAML::Node& node, const std::string& key) const {
+    const std::string value = text(node, key);
+    const SceneKey* declared = find_scene_key(key);
+    if (!declared) throw std::logic_error("scene key '" + key + "' is not declared (sim/scene_keys.cpp)");
+    const std::vector<std::string>& allowed = declared->choices;
+    if (std::find(allowed.begin(), allowed.end(), value) == allowed.end())
+      fail(node, key, "must be one of '" + join(allowed, "', '") + "'");
+    return value;
   }
   // An open sleeve's axis (x, y or z) and the volume axes it implies (the other two).
   void open_axis(const YAML::Node& c, const std::string& key, std::array<bool, 3>& axes, int& axis) const {

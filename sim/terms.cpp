@@ -104,26 +104,28 @@ void add_pulls(const Scene& scene, Model& m) {
 
 // Dynamics: inertia (and viscous damping) only when the scene asks for them.
 void add_inertia(const Scene& scene, Model& m) {
-  if (!scene.dynamic) return;
+  if (!scene.dynamics) return;
   for (const auto& [region, params] : scene.materials)
     if (m.density[m.mesh.region(region, 3).id] <= 0)
       throw InputError(params.where("model"), "dynamics needs 'density' [kg/m^3] for material '" + region + "'");
-  m.inertia = std::make_shared<InertiaTerm>(m.mesh, m.partition, m.rank, m.density, scene.inertia);
+  m.inertia = std::make_shared<InertiaTerm>(m.mesh, m.partition, m.rank, m.density, scene.dynamics->inertia);
   m.assembler->add_term(m.inertia);
 }
 
 void add_damping(const Scene& scene, Model& m) {
-  if (!scene.dynamic || !(scene.shear_viscosity > 0 || scene.bulk_viscosity > 0)) return;
-  std::vector<double> eta(m.mesh.regions.size(), scene.shear_viscosity),
-      zeta(m.mesh.regions.size(), scene.bulk_viscosity);
-  m.damping = std::make_shared<DampingTerm>(m.mesh, m.partition, m.rank, eta, zeta, scene.inertia.scheme);
+  if (!scene.dynamics) return;
+  const DynamicsSpec& dynamics = *scene.dynamics;
+  if (!(dynamics.shear_viscosity > 0 || dynamics.bulk_viscosity > 0)) return;
+  std::vector<double> eta(m.mesh.regions.size(), dynamics.shear_viscosity),
+      zeta(m.mesh.regions.size(), dynamics.bulk_viscosity);
+  m.damping = std::make_shared<DampingTerm>(m.mesh, m.partition, m.rank, eta, zeta, dynamics.inertia.scheme);
   m.assembler->add_term(m.damping);
 }
 
 // Ground contact only on the declared surfaces.
 void add_ground(const Scene& scene, Model& m) {
-  if (!scene.ground_contact) return;
-  GroundContactSpec spec = scene.ground;
+  if (!scene.ground) return;
+  GroundContactSpec spec = *scene.ground;
   // nearly incompressible: E = 2 mu (1 + nu) ~ 3 mu
   spec.young_modulus = 3.0 * contact_shear_modulus(m.mesh, m.materials, spec.surfaces);
   m.ground = std::make_shared<GroundContactTerm>(m.mesh, m.partition, m.rank, spec);
@@ -132,15 +134,15 @@ void add_ground(const Scene& scene, Model& m) {
 
 // Friction on the ground contact (none without it).
 void add_friction(const Scene& scene, Model& m) {
-  if (!scene.ground_contact || !scene.friction) return;
-  m.friction = std::make_shared<FrictionTerm>(m.mesh, m.partition, m.rank, m.ground, scene.friction_spec);
+  if (!scene.ground || !scene.friction) return;
+  m.friction = std::make_shared<FrictionTerm>(m.mesh, m.partition, m.rank, m.ground, *scene.friction);
   m.assembler->add_term(m.friction);
 }
 
 // Self-contact only between the declared surface pairs.
 void add_self_contact(const Scene& scene, Model& m) {
   if (!scene.self_contact) return;
-  SelfContactSpec spec = scene.self_contact_spec;
+  SelfContactSpec spec = *scene.self_contact;
   std::vector<std::string> surfaces;
   for (const auto& [a, b] : spec.pairs) surfaces.insert(surfaces.end(), {a, b});
   spec.young_modulus = 3.0 * contact_shear_modulus(m.mesh, m.materials, surfaces);  // as for the ground
@@ -151,7 +153,7 @@ void add_self_contact(const Scene& scene, Model& m) {
 // The voxel lattice's floor contact (a diagnostic): a sphere per lattice voxel.
 void add_lattice_floor(const Scene& scene, Model& m) {
   if (!scene.lattice_floor) return;
-  m.assembler->add_term(std::make_shared<LatticeFloorTerm>(m.mesh, m.partition, m.rank, scene.lattice_floor_spec.floor,
+  m.assembler->add_term(std::make_shared<LatticeFloorTerm>(m.mesh, m.partition, m.rank, scene.lattice_floor->floor,
                                                            lattice_points(scene, m.mesh)));
 }
 
@@ -186,7 +188,8 @@ std::vector<LatticePoint> lattice_points(const Scene& scene, const Mesh& mesh) {
   const std::string key = scene_key(scene, "", "contact.lattice_floor");
   if (scene.geometry.string("type", "") != "robot_voxel")
     throw InputError(key, "needs geometry.type robot_voxel (the lattice is the voxel study's)");
-  const LatticeFloorScene& spec = scene.lattice_floor_spec;
+  if (!scene.lattice_floor) throw InputError(key, "the scene declares no lattice floor");
+  const LatticeFloorScene& spec = *scene.lattice_floor;
   for (const auto& [region, value] : spec.mu)
     if (!mesh.has_region(region, 3)) throw InputError(key + ".mu", "the mesh has no volume region '" + region + "'");
   const double voxel = spec.voxel_size;

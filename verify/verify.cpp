@@ -395,15 +395,14 @@ Scene sliding_block_scene(const std::string& name, const TimeFunction& mu, doubl
       verification_scene(name, cube_geometry(L, L / 2, 1),
                          verification_params({{"mu", 1e7}, {"nu", 0.3}, {"density", 1000}}, "model", "neo_hookean"));
   s.gravity = Eigen::Vector3d(g * std::sin(slope), 0, -g * std::cos(slope));
-  s.dynamic = true;
-  s.inertia.scheme = TimeScheme::implicit_euler;
-  s.ground_contact = true;
-  s.ground.surfaces = {"zmin"};
-  s.ground.dhat = dhat;
-  s.ground.point = Eigen::Vector3d(0, 0, -0.9985 * dhat);  // the resting barrier gap under the weight
-  s.friction = true;
-  s.friction_spec.eps_v = eps_v;  // stick creep ~ eps_v (1 - sqrt(1 - q)) per second, q = load / (mu N)
-  s.friction_spec.regions.push_back({"zmin", mu, mu});
+  s.dynamics.emplace().inertia.scheme = TimeScheme::implicit_euler;
+  GroundContactSpec& ground = s.ground.emplace();
+  ground.surfaces = {"zmin"};
+  ground.dhat = dhat;
+  ground.point = Eigen::Vector3d(0, 0, -0.9985 * dhat);  // the resting barrier gap under the weight
+  FrictionSpec& friction = s.friction.emplace();
+  friction.eps_v = eps_v;  // stick creep ~ eps_v (1 - sqrt(1 - q)) per second, q = load / (mu N)
+  friction.regions.push_back({"zmin", mu, mu});
   s.solver.t_end = t_end;
   s.solver.dt_initial = s.solver.dt_max = dt;
   return s;

@@ -85,16 +85,15 @@ RollingResult run_rolling(const RollingSetup& setup, const VerifyOptions& opt, M
     return b;
   };
   scene.body_force_degree = 2;
-  scene.dynamic = true;
-  scene.inertia.scheme = TimeScheme::implicit_euler;
-  scene.ground_contact = true;
-  scene.ground.surfaces = {"outer"};
-  scene.ground.normal = n;
-  scene.ground.dhat = dhat;
-  scene.ground.point = -(setup.radius + 0.9 * dhat) * n;  // barely inside the barrier: settles without a drop
-  scene.friction = true;
-  scene.friction_spec.eps_v = 1e-3;  // [m/s]; rolling needs mu N >= f = m g sin / 3: creep ~ 0.1 eps_v
-  scene.friction_spec.regions.push_back({"outer", TimeFunction::constant(setup.mu), TimeFunction::constant(setup.mu)});
+  scene.dynamics.emplace().inertia.scheme = TimeScheme::implicit_euler;
+  GroundContactSpec& ground = scene.ground.emplace();
+  ground.surfaces = {"outer"};
+  ground.normal = n;
+  ground.dhat = dhat;
+  ground.point = -(setup.radius + 0.9 * dhat) * n;  // barely inside the barrier: settles without a drop
+  FrictionSpec& friction = scene.friction.emplace();
+  friction.eps_v = 1e-3;  // [m/s]; rolling needs mu N >= f = m g sin / 3: creep ~ 0.1 eps_v
+  friction.regions.push_back({"outer", TimeFunction::constant(setup.mu), TimeFunction::constant(setup.mu)});
   scene.solver.t_end = setup.t_release + setup.t_roll;
   scene.solver.dt_initial = scene.solver.dt_max = setup.dt;
   scene.solver.output_times = {setup.t_release};
@@ -164,11 +163,11 @@ HertzResult run_hertz(const HertzSetup& setup, const VerifyOptions& opt, MPI_Com
     b.components[axis] = true;
     scene.boundary.push_back(b);
   }
-  scene.ground_contact = true;
-  scene.ground.surfaces = {"sphere"};
-  scene.ground.dhat = setup.dhat;
-  scene.ground.kappa = kHertzE;  // barrier stiffness [Pa]
-  scene.ground.point = Eigen::Vector3d(0, 0, -R - setup.dhat);
+  GroundContactSpec& ground = scene.ground.emplace();
+  ground.surfaces = {"sphere"};
+  ground.dhat = setup.dhat;
+  ground.kappa = kHertzE;  // barrier stiffness [Pa]
+  ground.point = Eigen::Vector3d(0, 0, -R - setup.dhat);
   scene.solver.t_end = 1.0;
   scene.solver.dt_initial = 0.25;
   scene.solver.dt_max = 0.5;
@@ -182,10 +181,10 @@ HertzResult run_hertz(const HertzSetup& setup, const VerifyOptions& opt, MPI_Com
   for (int a = 0; a < mesh.n_nodes(); ++a) {
     if (area[a] <= 0) continue;
     const Eigen::Vector3d x = mesh.X.row(a).transpose() + result.run.u.row(a).transpose();
-    const double gap = x.z() - scene.ground.point.z();
+    const double gap = x.z() - scene.ground->point.z();
     if (gap >= setup.dhat) continue;
     if (!(gap > 0)) throw SolveError("Hertz contact: a node passed through the plane");
-    const double f = area[a] * scene.ground.kappa * -barrier_dphi(gap / setup.dhat);
+    const double f = area[a] * scene.ground->kappa * -barrier_dphi(gap / setup.dhat);
     force += f;
     moment += f * (x.x() * x.x() + x.y() * x.y());
   }

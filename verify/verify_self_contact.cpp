@@ -234,15 +234,15 @@ Scene tube_vacuum_scene(const std::string& mesh_file, BarrierHessian hessian) {
   // Gentle at first (the walls meet near 1 kPa), then up to the full vacuum.
   cavity.pressure = TimeFunction({{0.0, 0.0}, {0.5, -0.05 * kVacuum}, {1.0, -kVacuum}});
   s.cavities.push_back(cavity);
-  s.self_contact = true;
-  s.self_contact_spec.pairs = {{"cavity_top", "cavity_bottom"}};
-  s.self_contact_spec.dhat = kDhat;
-  s.self_contact_spec.kappa = 3 * kMu;
-  s.self_contact_spec.inflation = kInflation;
+  SelfContactSpec& contact = s.self_contact.emplace();
+  contact.pairs = {{"cavity_top", "cavity_bottom"}};
+  contact.dhat = kDhat;
+  contact.kappa = 3 * kMu;
+  contact.inflation = kInflation;
   // The exact barrier Hessian: the walls' elastic stiffness keeps the total Hessian
   // positive near equilibrium, and per-pair PSD projection in every iteration makes
   // Newton converge only linearly (measured: many steps stalled at 30 iterations).
-  s.self_contact_spec.project_hessian = hessian == BarrierHessian::adaptive;
+  contact.project_hessian = hessian == BarrierHessian::adaptive;
   s.solver.hessian_projection =
       hessian == BarrierHessian::adaptive ? HessianProjection::adaptive : HessianProjection::always;
   s.solver.t_end = 1.0;
@@ -263,7 +263,7 @@ void measure_flattened_contact(const Scene& s, const SimulationResult& r, TubeVa
   Partition serial;
   serial.cell_part.assign(mesh.n_cells(), 0);
   serial.node_begin = {0, mesh.n_nodes()};
-  SelfContactTerm contact(mesh, serial, 0, s.self_contact_spec);
+  SelfContactTerm contact(mesh, serial, 0, *s.self_contact);
   contact.refresh(r.u);
   const SelfContactNodal c = contact.nodal_contact(r.u);
   CavityPressureTerm vacuum(mesh, serial, 0, s.cavities.front());

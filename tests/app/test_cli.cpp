@@ -32,6 +32,7 @@ std::vector<Case> cases() {
       {"fit-materials", {}, fit_materials_command},
       {"search", {}, with_comm(search_command)},
   };
+  out.push_back({"scene-keys", {}, scene_keys_command});
   for (const char* sub :
        {"validate", "ladder", "spread", "morph", "friction-sweep", "friction-drag", "benchmark", "levels"})
     out.push_back({std::string("robot ") + sub, {sub}, with_comm(robot_command)});

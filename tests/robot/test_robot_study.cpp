@@ -135,7 +135,7 @@ TEST(RobotStudy, PhysicalInchingCasesPlayOnTheFullLengthBody) {
   EXPECT_EQ(chambers, 8);
   ASSERT_TRUE(scene.friction);
   std::map<std::string, const FrictionRegion*> regions;
-  for (const auto& r : scene.friction_spec.regions) regions[r.surface] = &r;
+  for (const auto& r : scene.friction->regions) regions[r.surface] = &r;
   ASSERT_TRUE(regions.count("foot_a") && regions.count("foot_b"));
   EXPECT_NEAR(regions["foot_b"]->mu_static(odd), 0.70, 1e-9);
   EXPECT_NEAR(regions["foot_a"]->mu_static(odd), 0.56, 1e-9);
@@ -188,9 +188,9 @@ TEST(RobotStudy, LatticeMechanicsCasesPutTheBodyOnTheLatticesSpheres) {
     const YAML::Node doc = robot_scene_yaml(c, find_robot_fidelity("0.02:2:0.05"), "");
     const Scene scene = scene_from_yaml(doc, c.template_scene);
     EXPECT_TRUE(scene.lattice_floor) << c.name;
-    EXPECT_FALSE(scene.ground_contact) << c.name;
+    EXPECT_FALSE(scene.ground) << c.name;
     EXPECT_FALSE(scene.friction) << c.name;  // feet switch on the spheres
-    EXPECT_EQ(scene.lattice_floor_spec.feet.size(), 2u) << c.name;
+    EXPECT_EQ(scene.lattice_floor->feet.size(), 2u) << c.name;
     EXPECT_EQ(scene.materials.at("bladder_5").number("mu"), 1388889) << c.name;  // 12.5 x 111111 Pa
     EXPECT_EQ(scene.materials.at("skin").number("mu"), 200000) << c.name;
     EXPECT_EQ(doc["materials"]["bladder_3"]["density"].as<double>(), 15000) << c.name;

@@ -579,7 +579,7 @@ TEST(Scene, LatticePointsOfTheVoxelPresetCarryFeetAndGrowingRadii) {
   const Scene scene = read_scene(s.file.string());
   ASSERT_TRUE(scene.lattice_floor);
   ASSERT_FALSE(scene.friction);  // the feet went to the lattice floor
-  ASSERT_EQ(scene.lattice_floor_spec.feet.size(), 2u);
+  ASSERT_EQ(scene.lattice_floor->feet.size(), 2u);
   const Mesh mesh = build_scene_mesh(scene, PETSC_COMM_WORLD);
   const std::vector<LatticePoint> points = lattice_points(scene, mesh);
   ASSERT_EQ(points.size(), 1428u);

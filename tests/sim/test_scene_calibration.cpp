@@ -51,9 +51,9 @@ TEST_F(SceneCalibration, CoefficientsComeFromTheFileAndAreRecorded) {
   const Scene s =
       read_scene(scene("mu_static: {calibration: wood.yaml, parameter: mu_static}, "
                        "mu_kinetic: {calibration: wood.yaml, parameter: mu_kinetic}"));
-  ASSERT_EQ(s.friction_spec.regions.size(), 1u);
-  EXPECT_DOUBLE_EQ(s.friction_spec.regions[0].mu_static(1.0), 0.7024);
-  EXPECT_DOUBLE_EQ(s.friction_spec.regions[0].mu_kinetic(1.0), 0.5998);
+  ASSERT_EQ(s.friction->regions.size(), 1u);
+  EXPECT_DOUBLE_EQ(s.friction->regions[0].mu_static(1.0), 0.7024);
+  EXPECT_DOUBLE_EQ(s.friction->regions[0].mu_kinetic(1.0), 0.5998);
   ASSERT_EQ(s.calibrations.size(), 2u);
   EXPECT_EQ(s.calibrations[0].parameter, "mu_static");
   EXPECT_EQ(s.calibrations[0].kind, "friction");

@@ -119,7 +119,7 @@ Scene voxel_lattice_scene() {
 }
 
 void set_floor_under_lattice(Scene& scene, const Mesh& mesh) {
-  LatticeFloorSpec& floor = scene.lattice_floor_spec.floor;
+  LatticeFloorSpec& floor = scene.lattice_floor->floor;
   double lowest = std::numeric_limits<double>::infinity();
   for (const LatticePoint& p : lattice_points(scene, mesh)) {
     double z = 0;
@@ -234,7 +234,7 @@ DerivativeErrors check_term(const BuiltScene& b, const std::shared_ptr<EnergyTer
   term->set_exact_hessian(true);  // projected barrier/friction Hessians are not derivatives
   if (term->refresh_pieces(a, u0)) a.setup();
   if (auto inertia = std::dynamic_pointer_cast<InertiaTerm>(term)) {
-    const Eigen::Vector3d v0 = b.scene.initial_velocity;
+    const Eigen::Vector3d v0 = b.scene.dynamics->initial_velocity;
     inertia->set_initial_velocity([v0](const Eigen::Vector3d&) { return v0; });
     inertia->initialize(a, u0, kT0);
   }
@@ -354,7 +354,7 @@ TEST(TermDerivatives, EveryBuilderTermMatchesFiniteDifferences) {
   check("shell P1", *shell, settings(shell->mesh, std::numeric_limits<double>::infinity(), 3, 0));
   // Thousands of dofs: those of a few random pieces of each term.
   const auto voxel = build_terms(voxel_lattice_scene(), true);
-  check("voxel lattice", *voxel, settings(voxel->mesh, 0.5 * voxel->scene.lattice_floor_spec.floor.dhat, 2, 24));
+  check("voxel lattice", *voxel, settings(voxel->mesh, 0.5 * voxel->scene.lattice_floor->floor.dhat, 2, 24));
   for (const NamedTermBuilder& builder : term_builders())
     EXPECT_TRUE(covered.count(builder.name) || kSkippedBuilders.count(builder.name))
         << "builder '" << builder.name << "' made no term in the scenes of this test: add its section to one";

@@ -161,12 +161,12 @@ TEST(SelfContactScene, ReadsTheSelfKeyAndRejectsBadInput) {
       head + "contact:\n  self: {pairs: [[zmin, zmax], [xmin, xmin]], dhat: 1e-4, kappa: 3e5, inflation: 1e-3}\n");
   const Scene scene = read_scene(good);
   EXPECT_TRUE(scene.self_contact);
-  ASSERT_EQ(scene.self_contact_spec.pairs.size(), 2u);
-  EXPECT_EQ(scene.self_contact_spec.pairs[0].first, "zmin");
-  EXPECT_EQ(scene.self_contact_spec.pairs[1].second, "xmin");
-  EXPECT_DOUBLE_EQ(scene.self_contact_spec.dhat, 1e-4);
-  EXPECT_DOUBLE_EQ(scene.self_contact_spec.kappa, 3e5);
-  EXPECT_DOUBLE_EQ(scene.self_contact_spec.inflation, 1e-3);
+  ASSERT_EQ(scene.self_contact->pairs.size(), 2u);
+  EXPECT_EQ(scene.self_contact->pairs[0].first, "zmin");
+  EXPECT_EQ(scene.self_contact->pairs[1].second, "xmin");
+  EXPECT_DOUBLE_EQ(scene.self_contact->dhat, 1e-4);
+  EXPECT_DOUBLE_EQ(scene.self_contact->kappa, 3e5);
+  EXPECT_DOUBLE_EQ(scene.self_contact->inflation, 1e-3);
   std::filesystem::remove(good);
   EXPECT_FALSE(read_scene(write_scene("morphfem_self_none.yaml", head)).self_contact);
   std::filesystem::remove(std::filesystem::temp_directory_path() / "morphfem_self_none.yaml");
