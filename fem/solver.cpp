@@ -15,7 +15,7 @@ namespace morphfem {
 namespace {
 
 PetscErrorCode form_function(SNES snes, Vec u, Vec r, void* ctx) {
-  auto* self = static_cast<QuasiStaticSolver*>(ctx);
+  auto* self = static_cast<IncrementalSolver*>(ctx);
   try {
     double e = self->assembler().gradient(u, r);
     if (!std::isfinite(e)) PetscCall(SNESSetFunctionDomainError(snes));
@@ -26,32 +26,32 @@ PetscErrorCode form_function(SNES snes, Vec u, Vec r, void* ctx) {
 }
 
 PetscErrorCode form_jacobian(SNES, Vec u, Mat J, Mat P, void* ctx) {
-  return static_cast<QuasiStaticSolver*>(ctx)->jacobian(u, J, P);
+  return static_cast<IncrementalSolver*>(ctx)->jacobian(u, J, P);
 }
 
 PetscErrorCode shell_mult(Mat J, Vec x, Vec y) {
   void* ctx;
   PetscCall(MatShellGetContext(J, &ctx));
-  return static_cast<QuasiStaticSolver*>(ctx)->operator_mult(x, y);
+  return static_cast<IncrementalSolver*>(ctx)->operator_mult(x, y);
 }
 
 PetscErrorCode form_objective(SNES, Vec u, PetscReal* e, void* ctx) {
-  *e = static_cast<QuasiStaticSolver*>(ctx)->assembler().energy(u);
+  *e = static_cast<IncrementalSolver*>(ctx)->assembler().energy(u);
   return 0;
 }
 
 PetscErrorCode line_search_trampoline(SNESLineSearch ls, void* ctx) {
-  return static_cast<QuasiStaticSolver*>(ctx)->line_search(ls);
+  return static_cast<IncrementalSolver*>(ctx)->line_search(ls);
 }
 
 PetscErrorCode convergence_trampoline(SNES snes, PetscInt it, PetscReal, PetscReal snorm, PetscReal fnorm,
                                       SNESConvergedReason* reason, void* ctx) {
-  return static_cast<QuasiStaticSolver*>(ctx)->convergence(snes, it, snorm, fnorm, reason);
+  return static_cast<IncrementalSolver*>(ctx)->convergence(snes, it, snorm, fnorm, reason);
 }
 
 }  // namespace
 
-QuasiStaticSolver::QuasiStaticSolver(Assembler& assembler, std::vector<DirichletCondition> bcs, SolverOptions options)
+IncrementalSolver::IncrementalSolver(Assembler& assembler, std::vector<DirichletCondition> bcs, SolverOptions options)
     : assembler_(assembler), bcs_(std::move(bcs)), opt_(std::move(options)) {
   PETSC_CHECK(PetscOptionsGetBool(nullptr, nullptr, "-morphfem_linesearch_monitor", &linesearch_monitor_, nullptr));
   PETSC_CHECK(PetscOptionsGetBool(nullptr, nullptr, "-morphfem_step_monitor", &step_monitor_, nullptr));
@@ -112,7 +112,7 @@ QuasiStaticSolver::QuasiStaticSolver(Assembler& assembler, std::vector<Dirichlet
   apply_dirichlet(u_, 0.0);
 }
 
-QuasiStaticSolver::~QuasiStaticSolver() {
+IncrementalSolver::~IncrementalSolver() {
   clear_low_rank();
   SNESDestroy(&snes_);
   if (J_) MatDestroy(&J_);
@@ -122,7 +122,7 @@ QuasiStaticSolver::~QuasiStaticSolver() {
   VecDestroy(&work_);
 }
 
-void QuasiStaticSolver::set_jacobian() {
+void IncrementalSolver::set_jacobian() {
   bool any_low_rank = false;
   for (const auto& term : assembler_.terms()) any_low_rank = any_low_rank || term->has_low_rank();
   if (any_low_rank) {
@@ -141,7 +141,7 @@ void QuasiStaticSolver::set_jacobian() {
 }
 
 // Rigid-body modes from the reference coordinates of the owned nodes (GAMG).
-void QuasiStaticSolver::attach_near_nullspace() {
+void IncrementalSolver::attach_near_nullspace() {
   Vec coords = assembler_.create_vector();
   assembler_.scatter_all(assembler_.mesh().X, coords);
   MatNullSpace near_null;
@@ -155,7 +155,7 @@ void QuasiStaticSolver::attach_near_nullspace() {
 // rebuild its ghost scatter and nonzero pattern; the Hessian is re-created with
 // the new pattern and handed to SNES (the linear solver re-factors it anyway at
 // the next Newton iteration). Terms that never change keep everything as it was.
-void QuasiStaticSolver::refresh_pieces() {
+void IncrementalSolver::refresh_pieces() {
   static const PetscLogEvent event = log_event("RefreshPieces");
   LogEventScope scope(event);
   int changed = 0;
@@ -167,7 +167,7 @@ void QuasiStaticSolver::refresh_pieces() {
   ++pattern_rebuilds_;
 }
 
-void QuasiStaticSolver::rebuild_pattern() {
+void IncrementalSolver::rebuild_pattern() {
   static const PetscLogEvent event = log_event("PatternRebuild");
   LogEventScope scope(event);
   assembler_.setup();
@@ -177,7 +177,7 @@ void QuasiStaticSolver::rebuild_pattern() {
   set_jacobian();
 }
 
-void QuasiStaticSolver::save_state(StateRecord& state) {
+void IncrementalSolver::save_state(StateRecord& state) {
   static const PetscLogEvent event = log_event("SolverSave");
   LogEventScope scope(event);
   const RunStats& counters = counters_;
@@ -204,7 +204,7 @@ void QuasiStaticSolver::save_state(StateRecord& state) {
   }
 }
 
-RunStats QuasiStaticSolver::load_state(const StateRecord& state, const std::string& where) {
+RunStats IncrementalSolver::load_state(const StateRecord& state, const std::string& where) {
   const auto& terms = assembler_.terms();
   if (state.integer("solver.terms", where) != static_cast<long>(terms.size()))
     throw InputError(where, "the checkpoint has " + std::to_string(state.integer("solver.terms", where)) +
@@ -243,12 +243,12 @@ RunStats QuasiStaticSolver::load_state(const StateRecord& state, const std::stri
   return counters;
 }
 
-void QuasiStaticSolver::clear_low_rank() {
+void IncrementalSolver::clear_low_rank() {
   for (auto& lr : low_rank_) VecDestroy(&lr.v);
   low_rank_.clear();
 }
 
-PetscErrorCode QuasiStaticSolver::jacobian(Vec u, Mat J, Mat P) {
+PetscErrorCode IncrementalSolver::jacobian(Vec u, Mat J, Mat P) {
   try {
     for (const auto& term : assembler_.terms()) term->set_exact_hessian(exact_hessian_);
     if (exact_hessian_) ++exact_hessian_its_;
@@ -270,7 +270,7 @@ PetscErrorCode QuasiStaticSolver::jacobian(Vec u, Mat J, Mat P) {
   return 0;
 }
 
-PetscErrorCode QuasiStaticSolver::operator_mult(Vec x, Vec y) {
+PetscErrorCode IncrementalSolver::operator_mult(Vec x, Vec y) {
   PetscCall(MatMult(H_, x, y));
   for (const auto& lr : low_rank_) {
     PetscScalar dot;
@@ -280,7 +280,7 @@ PetscErrorCode QuasiStaticSolver::operator_mult(Vec x, Vec y) {
   return 0;
 }
 
-void QuasiStaticSolver::apply_dirichlet(Vec u, double t) const {
+void IncrementalSolver::apply_dirichlet(Vec u, double t) const {
   const PetscInt begin = assembler_.owned_dof_begin(), end = assembler_.owned_dof_end();
   const Mesh& mesh = assembler_.mesh();
   PetscScalar* a;
@@ -296,7 +296,7 @@ void QuasiStaticSolver::apply_dirichlet(Vec u, double t) const {
 }
 
 // max_a |v_a| over the nodes a (3 dofs each) of v (collective) [units of v].
-double QuasiStaticSolver::largest_nodal_norm(Vec v) const {
+double IncrementalSolver::largest_nodal_norm(Vec v) const {
   const PetscScalar* a;
   PetscInt n = 0;
   PETSC_CHECK(VecGetLocalSize(v, &n));
@@ -310,7 +310,7 @@ double QuasiStaticSolver::largest_nodal_norm(Vec v) const {
   return total;
 }
 
-double QuasiStaticSolver::admissible_step(Vec u, Vec du, std::string* limiter) {
+double IncrementalSolver::admissible_step(Vec u, Vec du, std::string* limiter) {
   const auto& terms = assembler_.terms();
   if (max_step_events_.size() != terms.size()) {
     max_step_events_.clear();
@@ -332,7 +332,7 @@ double QuasiStaticSolver::admissible_step(Vec u, Vec du, std::string* limiter) {
 // -morphfem_linesearch_monitor: the admissible step, the term that bounds it, and
 // the accepted step (diagnosing stagnating Newton iterations); after a backtrack,
 // which terms' energies rose over the largest step. W is left at X - lambda Y.
-PetscErrorCode QuasiStaticSolver::print_line_search(Vec X, Vec Y, Vec W, double lambda_max, const std::string& limiter,
+PetscErrorCode IncrementalSolver::print_line_search(Vec X, Vec Y, Vec W, double lambda_max, const std::string& limiter,
                                                     double lambda, bool accepted, double slope) {
   PetscCall(PetscPrintf(assembler_.comm(), "      line search: max step %.3e (%s), %s %.3e, slope %.3e, %s Hessian\n",
                         lambda_max, limiter.c_str(), accepted ? "accepted" : "rejected down to", lambda, slope,
@@ -351,7 +351,7 @@ PetscErrorCode QuasiStaticSolver::print_line_search(Vec X, Vec Y, Vec W, double 
 // Energy-based backtracking (Armijo) along the Newton direction: W = X - lambda Y.
 // Rejects states with infinite energy (outside the domain); if the direction is
 // not a descent direction (indefinite Hessian), falls back to steepest descent.
-PetscErrorCode QuasiStaticSolver::line_search(SNESLineSearch ls) {
+PetscErrorCode IncrementalSolver::line_search(SNESLineSearch ls) {
   Vec X, F, Y, W, G;
   PetscCall(SNESLineSearchGetVecs(ls, &X, &F, &Y, &W, &G));
   SNES snes;
@@ -464,7 +464,7 @@ bool full_newton_step(SNES snes) {
 // one step, then 50 iterations wandering at 1.8-2.0e-10 N).
 // With SolverOptions::newton_velocity_tol > 0, also converged when the last Newton
 // direction moves no node by more than tol * dt [m].
-PetscErrorCode QuasiStaticSolver::convergence(SNES snes, PetscInt it, PetscReal snorm, PetscReal fnorm,
+PetscErrorCode IncrementalSolver::convergence(SNES snes, PetscInt it, PetscReal snorm, PetscReal fnorm,
                                               SNESConvergedReason* reason) {
   *reason = SNES_CONVERGED_ITERATING;
   if (it == 0) {
@@ -498,7 +498,7 @@ PetscErrorCode QuasiStaticSolver::convergence(SNES snes, PetscInt it, PetscReal 
 // velocity times dt; SolverOptions::extrapolate) or u_n, scaled back to stay
 // admissible, with the prescribed values at t_new. False (why, cause_) if even u_n
 // with the prescribed increment is outside the energy's domain.
-bool QuasiStaticSolver::predict(double t_new, std::string& why) {
+bool IncrementalSolver::predict(double t_new, std::string& why) {
   static const PetscLogEvent event = log_event("Predictor");
   LogEventScope scope(event);
   PETSC_CHECK(VecCopy(u_, work_));
@@ -525,7 +525,7 @@ bool QuasiStaticSolver::predict(double t_new, std::string& why) {
   return true;
 }
 
-bool QuasiStaticSolver::solve_step(double t_new, int& newton_its, int& linear_its, std::string& why) {
+bool IncrementalSolver::solve_step(double t_new, int& newton_its, int& linear_its, std::string& why) {
   static const PetscLogEvent hooks_event = log_event("StepHooks");
   refresh_pieces();
   const double dt = t_new - t_;
@@ -597,7 +597,7 @@ bool QuasiStaticSolver::solve_step(double t_new, int& newton_its, int& linear_it
   return ok;
 }
 
-RunStats QuasiStaticSolver::run(const std::function<void(const StepReport&)>& on_step) {
+RunStats IncrementalSolver::run(const std::function<void(const StepReport&)>& on_step) {
   auto start = std::chrono::steady_clock::now();
   RunStats stats = counters_;
   stats.completed = false;

@@ -1,5 +1,7 @@
-// Quasi-static solver: pseudo-time t in [0, t_end] drives every time-dependent
-// load and prescribed displacement; each step minimises the total energy with
+// Incremental solver: time t in [0, t_end] (pseudo-time for a quasi-static scene)
+// drives every time-dependent load and prescribed displacement; each step minimises
+// the step's incremental potential (the total energy, plus inertia's and damping's
+// terms in a dynamic scene, fem/inertia.h) with
 // Newton (PETSc SNES) and an energy-based backtracking line search that never
 // accepts a state outside the energy's domain (an inverted element) and always
 // decreases the energy. Steps adapt: a failed solve is cut and retried from the
@@ -96,12 +98,12 @@ struct RunStats {
   std::string failure;  // diagnostic if !completed
 };
 
-class QuasiStaticSolver {
+class IncrementalSolver {
  public:
-  QuasiStaticSolver(Assembler& assembler, std::vector<DirichletCondition> bcs, SolverOptions options);
-  ~QuasiStaticSolver();
-  QuasiStaticSolver(const QuasiStaticSolver&) = delete;
-  QuasiStaticSolver& operator=(const QuasiStaticSolver&) = delete;
+  IncrementalSolver(Assembler& assembler, std::vector<DirichletCondition> bcs, SolverOptions options);
+  ~IncrementalSolver();
+  IncrementalSolver(const IncrementalSolver&) = delete;
+  IncrementalSolver& operator=(const IncrementalSolver&) = delete;
 
   // Runs from the current state and time to t_end, calling on_step after each
   // converged step. On failure (no convergence at dt_min) the solution keeps the

@@ -153,7 +153,7 @@ std::unique_ptr<Model> build_model(const Scene& scene, Mesh& mesh, MPI_Comm comm
   model->assembler = std::make_unique<Assembler>(mesh, model->partition, comm);
   for (const NamedTermBuilder& builder : term_builders()) builder.build(scene, *model);
   model->solver =
-      std::make_unique<QuasiStaticSolver>(*model->assembler, boundary_conditions(scene, mesh), scene.solver);
+      std::make_unique<IncrementalSolver>(*model->assembler, boundary_conditions(scene, mesh), scene.solver);
   start_inertia(*model);
   return model;
 }

@@ -42,7 +42,7 @@ struct Model {
   double mass_kg = 0;                                      // sum of rho V over the cells [kg]
   Partition partition;
   std::unique_ptr<Assembler> assembler;
-  std::unique_ptr<QuasiStaticSolver> solver;
+  std::unique_ptr<IncrementalSolver> solver;
 
   // The terms the observers read; null or empty when the scene has none.
   std::shared_ptr<ElasticTerm> elastic;

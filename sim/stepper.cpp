@@ -167,7 +167,7 @@ bool Stepper::checkpoint_due(bool last) const {
   return due != 0;
 }
 
-// Checkpoints: the solver and its terms (QuasiStaticSolver::save_state), what
+// Checkpoints: the solver and its terms (IncrementalSolver::save_state), what
 // identifies the run, and what the loop and the observers accumulate.
 // Collective; rank 0 writes.
 void Stepper::save_checkpoint(const std::string& dir) {

@@ -167,7 +167,7 @@ Trace trace_volume(OctantShell& shell, double la_end, const std::vector<double>&
   options.dt_min = 1e-5;
   options.max_outer_updates = 30;
   for (double la : la_samples) options.output_times.push_back(la - 1.0);
-  QuasiStaticSolver solver(shell.assembler(), shell.bcs(), options);
+  IncrementalSolver solver(shell.assembler(), shell.bcs(), options);
   Trace trace;
   trace.dofs = shell.assembler().n_dofs();
   Progress bar(label, t_end, progress);
@@ -356,7 +356,7 @@ PressureControlFailure run_pressure_controlled_balloon(bool quick, MPI_Comm comm
   options.dt_max = 0.1;
   options.dt_min = quick ? 2e-3 : 1e-4;
   options.max_newton_its = 25;
-  QuasiStaticSolver solver(shell.assembler(), shell.bcs(), options);
+  IncrementalSolver solver(shell.assembler(), shell.bcs(), options);
   const double V_ref = shell.reference_volume();
   result.dofs = shell.assembler().n_dofs();
   result.stats = solver.run();
@@ -415,7 +415,7 @@ FillResult fill_time(double supply, double C, double initial_gauge, double targe
   SolverOptions options;
   options.t_end = 1.5 * r.expected;
   options.dt_initial = options.dt_max = tau / 100;
-  QuasiStaticSolver solver(shell.assembler(), shell.bcs(), options);
+  IncrementalSolver solver(shell.assembler(), shell.bcs(), options);
   r.dofs = shell.assembler().n_dofs();
   double t_prev = 0, p_prev = gas->pressure();
   r.time = -1;

@@ -2,7 +2,7 @@
 // (../shared/VERIFICATION.md cases 3 and 5): limit points of inflated
 // spheres and balloons traced with volume control, graceful failure of pressure
 // control past a limit point, and the valve model's fill times. Built with the
-// lower-level API (octant meshes, Assembler, QuasiStaticSolver) because scenes
+// lower-level API (octant meshes, Assembler, IncrementalSolver) because scenes
 // have no gas cavities yet. Each appends VerificationRecords; P/mu etc. are
 // compared with the exact formulas at the stretch computed from the cavity volume.
 #pragma once

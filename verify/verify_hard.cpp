@@ -205,7 +205,7 @@ EndMomentResult run_end_moment(double L, double h, double mesh_size, double mu, 
   for (int n : mesh.nodes_of_surface("ymax")) sides.nodes.push_back(n);
   sides.components = {false, true, false};
   sides.value = clamp.value;
-  QuasiStaticSolver solver(assembler, {clamp, sides}, options);
+  IncrementalSolver solver(assembler, {clamp, sides}, options);
   out.run.dofs = assembler.n_dofs();
 
   const std::vector<int> tip_nodes = mesh.nodes_of_surface("tip"), root_nodes = mesh.nodes_of_surface("root");

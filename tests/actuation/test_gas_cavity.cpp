@@ -29,7 +29,7 @@ Mesh octant_shell(int order, double A, double B, double h) {
 }
 
 // Whole-term energy, dense gradient and Hessian at displacement u (n_nodes x 3),
-// assembled the way Assembler + QuasiStaticSolver do on one process.
+// assembled the way Assembler + IncrementalSolver do on one process.
 double term_energy(CavityVolumeTerm& term, const Mesh& mesh, const RowMatrixXd& u, Eigen::VectorXd* g,
                    Eigen::MatrixXd* H) {
   term.set_cavity_volume(term.wall().symmetry_factor * term.local_model_volume(u));

@@ -47,7 +47,7 @@ Profiled sagging_beam() {
   SolverOptions opt;
   opt.t_end = 1.0;
   opt.dt_initial = opt.dt_max = 0.25;
-  QuasiStaticSolver solver(assembler, {clamp}, opt);
+  IncrementalSolver solver(assembler, {clamp}, opt);
   Profiled r;
   const ProfileSnapshot before = profile_snapshot();
   r.stats = solver.run();

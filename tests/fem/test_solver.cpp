@@ -1,4 +1,4 @@
-// QuasiStaticSolver's adaptive Hessian projection (SolverOptions::hessian_projection)
+// IncrementalSolver's adaptive Hessian projection (SolverOptions::hessian_projection)
 // on a term whose exact Hessian is wrong on purpose, so that each of the two
 // fallbacks must carry the solve: a direction that does not descend (the exact
 // Hessian negative definite), and a descent direction along which the line search
@@ -66,7 +66,7 @@ Outcome solve(HessianProjection projection, double exact_scale) {
   opt.t_end = opt.dt_initial = opt.dt_max = 1.0;  // one step, the quartic regime (|w| ~ 1)
   opt.max_newton_its = 50;
   opt.hessian_projection = projection;
-  QuasiStaticSolver solver(assembler, {}, opt);
+  IncrementalSolver solver(assembler, {}, opt);
   Outcome r;
   r.stats = solver.run();
   r.error = (assembler.gather_all(solver.solution()) - term->target()).cwiseAbs().maxCoeff();
@@ -75,7 +75,7 @@ Outcome solve(HessianProjection projection, double exact_scale) {
 
 }  // namespace
 
-TEST(QuasiStaticSolver, AdaptiveProjectionFallsBackWhereTheExactHessianFails) {
+TEST(IncrementalSolver, AdaptiveProjectionFallsBackWhereTheExactHessianFails) {
   const Outcome always = solve(HessianProjection::always, -1.0);  // "always" never asks for the exact Hessian
   ASSERT_TRUE(always.stats.completed) << always.stats.failure;
   EXPECT_EQ(always.stats.steps, 1);
@@ -119,7 +119,7 @@ RunStats pull_in_steps(double newton_velocity_tol, bool extrapolate, double& err
   opt.max_newton_its = 50;
   opt.newton_velocity_tol = newton_velocity_tol;
   opt.extrapolate = extrapolate;
-  QuasiStaticSolver solver(assembler, {}, opt);
+  IncrementalSolver solver(assembler, {}, opt);
   const RunStats stats = solver.run();
   error = (assembler.gather_all(solver.solution()) - term->target()).cwiseAbs().maxCoeff();
   return stats;
@@ -131,7 +131,7 @@ RunStats pull_in_steps(double newton_velocity_tol, bool extrapolate, double& err
 // node faster than tol [m/s] over the step: a huge tolerance stops every solve after
 // one iteration, a tiny one changes nothing, a moderate one stops early with the
 // state within about tol * dt of the solution.
-TEST(QuasiStaticSolver, VelocityToleranceStopsNewtonOnTheDirection) {
+TEST(IncrementalSolver, VelocityToleranceStopsNewtonOnTheDirection) {
   double error_default = 0, error_huge = 0, error_tiny = 0, error_moderate = 0;
   const RunStats base = pull_in_steps(0.0, false, error_default);
   ASSERT_TRUE(base.completed) << base.failure;
@@ -154,7 +154,7 @@ TEST(QuasiStaticSolver, VelocityToleranceStopsNewtonOnTheDirection) {
 // SolverOptions::extrapolate: the solution moves linearly in time, so from the second
 // step on the extrapolated start (u_n + dt (u_n - u_{n-1}) / dt_{n-1}) is the
 // solution and Newton has nothing left to do; starting from u_n it has.
-TEST(QuasiStaticSolver, ExtrapolatedStartSavesIterationsOnALinearMotion) {
+TEST(IncrementalSolver, ExtrapolatedStartSavesIterationsOnALinearMotion) {
   double error_extrapolated = 0, error_from_last = 0;
   const RunStats extrapolated = pull_in_steps(0.0, true, error_extrapolated);
   const RunStats from_last = pull_in_steps(0.0, false, error_from_last);

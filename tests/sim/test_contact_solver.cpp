@@ -1,4 +1,4 @@
-// Ground contact and friction through the real solver (QuasiStaticSolver, PETSc):
+// Ground contact and friction through the real solver (IncrementalSolver, PETSc):
 // a block resting under gravity carries its weight; max_step never lets a node
 // reach the plane; a block on a slope (tilted gravity or an inclined plane) sticks
 // at tan(theta) = 0.9 mu and slides at 1.1 mu / at the VERIFICATION.md case-8
@@ -189,7 +189,7 @@ TEST(ContactSolver, RestingBlockCarriesItsWeight) {
     bcs[1] = {"ymin", scene.mesh.nodes_of_surface("ymin"), {false, true, false}, [](const Eigen::Vector3d&, double) {
                 return Eigen::Vector3d::Zero();
               }};
-    QuasiStaticSolver solver(*scene.assembler, bcs, fixed_steps(1.0, 1.0));
+    IncrementalSolver solver(*scene.assembler, bcs, fixed_steps(1.0, 1.0));
     const RunStats stats = solver.run();
     ASSERT_TRUE(stats.completed) << stats.failure;
     const Eigen::Vector3d force = scene.ground->total_force(*scene.assembler, solver.solution());
@@ -257,7 +257,7 @@ TEST(ContactSolver, MaxStepNeverAllowsPenetration) {
 TEST(ContactSolver, QuasiStaticBlockSticksBelowTheFrictionLimit) {
   const double mu = 0.5, eps_v = 1e-5;
   BlockScene scene(1, 0.05, 0.9 * mu, false, mu, false, eps_v, 1e-4);
-  QuasiStaticSolver solver(*scene.assembler, {}, fixed_steps(1.0, 0.1));
+  IncrementalSolver solver(*scene.assembler, {}, fixed_steps(1.0, 0.1));
   double creep_start = 0;
   const RunStats stats = solver.run([&](const StepReport& r) {
     if (r.step == 1) creep_start = scene.mean_displacement(solver.solution(), scene.downhill);
@@ -291,7 +291,7 @@ TEST(ContactSolver, DynamicBlockOnASlopeSticksOrSlidesAsCoulombPredicts) {
     {
       const double mu = 0.5;
       BlockScene scene(1, 0.05, 0.9 * mu, inclined, mu, true, 1e-5, 1e-4, stiff);
-      QuasiStaticSolver solver(*scene.assembler, {}, fixed_steps(1.0, h));
+      IncrementalSolver solver(*scene.assembler, {}, fixed_steps(1.0, h));
       const RunStats stats = solver.run();
       ASSERT_TRUE(stats.completed) << stats.failure;
       const double slip = scene.mean_displacement(solver.solution(), scene.downhill, "zmin");
@@ -301,7 +301,7 @@ TEST(ContactSolver, DynamicBlockOnASlopeSticksOrSlidesAsCoulombPredicts) {
     for (auto [slope, mu] : {std::pair{1.1 * 0.5, 0.5}, std::pair{0.5, 0.49}}) {
       const double t_end = 2.5;
       BlockScene scene(1, 0.05, slope, inclined, mu, true, 1e-4, 1e-4, stiff);
-      QuasiStaticSolver solver(*scene.assembler, {}, fixed_steps(t_end, h));
+      IncrementalSolver solver(*scene.assembler, {}, fixed_steps(t_end, h));
       std::vector<double> x;  // mean displacement downhill after each step
       const RunStats stats = solver.run(
           [&](const StepReport&) { x.push_back(scene.mean_displacement(solver.solution(), scene.downhill)); });

@@ -1,4 +1,4 @@
-// Implicit dynamics through the real solver (QuasiStaticSolver + InertiaTerm):
+// Implicit dynamics through the real solver (IncrementalSolver + InertiaTerm):
 //  - the assembled inertia and damping terms against finite differences, and
 //    history that a rejected step attempt leaves untouched;
 //  - free flight under gravity: x = x0 + v0 t + g t^2/2 exactly with Newmark and
@@ -234,7 +234,7 @@ TEST(Dynamics, FreeFlightUnderGravity) {
       opt.dt_max = 0.05;
       opt.grow = 1.5;
     }
-    QuasiStaticSolver solver(*scene.assembler, {}, opt);
+    IncrementalSolver solver(*scene.assembler, {}, opt);
     int steps = 0;
     const RunStats stats = solver.run([&](const StepReport&) { ++steps; });
     ASSERT_TRUE(stats.completed) << stats.failure;
@@ -260,7 +260,7 @@ TEST(Dynamics, FreeFlightUnderGravity) {
     options.scheme = TimeScheme::implicit_euler;
     Scene scene(make_mesh("block", 0.04, 0.02, 0.02, 0.01, 1), 1e5, 0.45, options, kGravity);
     scene.inertia->set_initial_velocity([](const Eigen::Vector3d&) { return kV0; });
-    QuasiStaticSolver solver(*scene.assembler, {}, fixed_steps(t_end, dt));
+    IncrementalSolver solver(*scene.assembler, {}, fixed_steps(t_end, dt));
     ASSERT_TRUE(solver.run().completed);
     const double error = max_deviation(*scene.assembler, solver.solution(), exact(t_end));
     EXPECT_NEAR(error, kGravity.norm() * dt * t_end / 2, 1e-10) << "dt " << dt;
@@ -287,7 +287,7 @@ SwingResult swing(TimeScheme scheme, double dt, int steps, double eta = 0.0) {
   Scene scene(make_mesh("cantilever", L, 0.02, 0.02, 0.01, 1), 1e5, 0.45, options, Eigen::Vector3d::Zero(), eta);
   scene.inertia->set_initial_velocity(
       [&](const Eigen::Vector3d& X) { return Eigen::Vector3d(0, 0, V * (X.x() / L) * (X.x() / L)); });
-  QuasiStaticSolver solver(*scene.assembler, {clamp(scene.mesh, "root")}, fixed_steps(steps * dt, dt));
+  IncrementalSolver solver(*scene.assembler, {clamp(scene.mesh, "root")}, fixed_steps(steps * dt, dt));
   scene.inertia->initialize(*scene.assembler, solver.solution(), 0.0);
   SwingResult r;
   r.energy0 = scene.total_energy(solver.solution());
@@ -361,7 +361,7 @@ BarResult axial_bar(TimeScheme scheme, int steps_per_period, double periods) {
       [&](const Eigen::Vector3d& X) { return Eigen::Vector3d(V * std::sin(M_PI * X.x() / (2 * L)), 0, 0); });
   const double dt = T / steps_per_period;
   const int steps = static_cast<int>(std::lround(periods * steps_per_period));
-  QuasiStaticSolver solver(*scene.assembler, {clamp(scene.mesh, "root")}, fixed_steps(steps * dt, dt));
+  IncrementalSolver solver(*scene.assembler, {clamp(scene.mesh, "root")}, fixed_steps(steps * dt, dt));
   const auto tip = scene.mesh.nodes_of_surface("tip");
   std::vector<double> times{0.0}, tip_u{0.0};
   const RunStats stats = solver.run([&](const StepReport& r) {

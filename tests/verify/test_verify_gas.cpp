@@ -156,7 +156,7 @@ TEST(GasCavityAssembled, VolumeControlHitsTargetAndGasHoldsIt) {
   assembler.add_term(control);
   SolverOptions opt;
   opt.dt_initial = opt.dt_max = 0.25;
-  QuasiStaticSolver solver(assembler, shell->bcs, opt);
+  IncrementalSolver solver(assembler, shell->bcs, opt);
   const RunStats stats = solver.run();
   ASSERT_TRUE(stats.completed) << stats.failure;
   EXPECT_NEAR(control->cavity_volume(), 1.5 * V_ref, 1e-7 * 1.5 * V_ref);
