@@ -4,7 +4,6 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
-#include <map>
 #include <numeric>
 #include <stdexcept>
 #include <unordered_map>
@@ -112,19 +111,16 @@ void Assembler::setup() {
   PETSC_CHECK(ISDestroy(&is));
   PETSC_CHECK(VecDestroy(&u));
 
-  // Nonzero pattern: a coordinate list of n x n blocks, one per distinct node list
-  // (in order) of the terms' pieces, so that the pieces of different terms on the
-  // same cell (elastic, damping, inertia) sum into one block before PETSc sees them,
-  // and every owned diagonal. Terms with a zero Hessian take no entries.
+  // Nonzero pattern: every piece's entries as a coordinate list, in the order
+  // hessian() visits them, and every owned diagonal.
   std::vector<PetscInt> idx;
   coo_i_.clear();
   coo_j_.clear();
   coo_offset_.assign(terms_.size(), {});
   block_first_.assign(terms_.size(), {});
   block_offset_.assign(terms_.size(), {});
-  std::map<std::vector<int>, std::size_t> block_of_nodes;
+  block_values_.clear();
   for (size_t t = 0; t < terms_.size(); ++t) {
-    if (terms_[t]->zero_hessian()) continue;
     if (terms_[t]->sparse_pieces()) {
       setup_shared_blocks(t);
       continue;
@@ -132,12 +128,10 @@ void Assembler::setup() {
     coo_offset_[t].resize(terms_[t]->n_pieces());
     for (int k = 0; k < terms_[t]->n_pieces(); ++k) {
       terms_[t]->piece_nodes(k, nodes);
-      auto [it, added] = block_of_nodes.try_emplace(nodes, coo_i_.size());
-      coo_offset_[t][k] = it->second;
-      if (!added) continue;
       idx.clear();
       for (int n : nodes)
         for (int i = 0; i < 3; ++i) idx.push_back(constrained_[3 * n + i] ? -1 : 3 * n + i);
+      coo_offset_[t][k] = coo_i_.size();
       for (PetscInt col : idx)
         for (PetscInt row : idx) {
           coo_i_.push_back(row);
@@ -159,6 +153,7 @@ void Assembler::setup_shared_blocks(std::size_t t) {
   std::vector<int> nodes;
   auto& first = block_first_[t];
   auto& offset = block_offset_[t];
+  const std::size_t values_begin = coo_i_.size();
   first.resize(term.n_pieces() + 1);
   for (int k = 0; k < term.n_pieces(); ++k) {
     first[k] = offset.size();
@@ -177,6 +172,7 @@ void Assembler::setup_shared_blocks(std::size_t t) {
       }
   }
   first[term.n_pieces()] = offset.size();
+  block_values_.emplace_back(values_begin, coo_i_.size());
 }
 
 const std::vector<double>& Assembler::gather(Vec u) {
@@ -202,7 +198,6 @@ double Assembler::sweep(Vec u, bool want_g, bool want_H, Visit&& visit) {
   double local = 0.0;
   const int kind = want_H ? 2 : want_g ? 1 : 0;  // the term's event: E:, G: or H:
   for (size_t t = 0; t < terms_.size(); ++t) {
-    if (want_H && terms_[t]->zero_hessian()) continue;
     LogEventScope event(term_events_[t][kind]);
     EnergyTerm& term = *terms_[t];
     term.prepare(*this, ghost_u_);
@@ -260,7 +255,8 @@ void Assembler::hessian(Vec u, Mat Hmat) {
   // Values go into the coordinate list built by setup() and reach PETSc in one
   // MatSetValuesCOO: measured on the voxel robot (3,060 dofs, P1), per-piece
   // MatSetValues took ~40 % of the run, most of it searching for columns.
-  std::fill(coo_v_.begin(), coo_v_.end(), 0.0);  // blocks sum the pieces that share them
+  for (const auto& [begin, end] : block_values_)  // the shared blocks sum their pieces
+    std::fill(coo_v_.begin() + static_cast<long>(begin), coo_v_.begin() + static_cast<long>(end), 0.0);
   sweep(u, false, true,
         [&](size_t t, int k, const std::vector<PetscInt>& idx, double energy, const Eigen::VectorXd&,
             const Eigen::MatrixXd& H) {
@@ -271,11 +267,13 @@ void Assembler::hessian(Vec u, Mat Hmat) {
           if (static_cast<std::size_t>(k) >= coo_offset_[t].size())
             throw std::logic_error("Assembler::hessian: a term gained pieces without setup()");
           const std::size_t n = idx.size(), begin = coo_offset_[t][k];
-          if (!std::isfinite(energy) || H.size() == 0) return;  // outside the domain, or no contribution
-          if (begin + n * n > coo_diagonal_ || H.rows() != static_cast<Eigen::Index>(n))
+          if (begin + n * n > coo_diagonal_ ||
+              (k + 1 < static_cast<int>(coo_offset_[t].size()) && coo_offset_[t][k + 1] != begin + n * n))
             throw std::logic_error("Assembler::hessian: a piece changed its nodes without setup()");
-          Eigen::Map<Eigen::VectorXd>(coo_v_.data() + begin, static_cast<Eigen::Index>(n * n)) +=
-              Eigen::Map<const Eigen::VectorXd>(H.data(), static_cast<Eigen::Index>(n * n));
+          if (std::isfinite(energy))
+            std::copy(H.data(), H.data() + n * n, coo_v_.begin() + static_cast<long>(begin));
+          else
+            std::fill_n(coo_v_.begin() + static_cast<long>(begin), n * n, 0.0);
         });
   for (PetscInt d = owned_dof_begin(); d < owned_dof_end(); ++d)
     coo_v_[coo_diagonal_ + static_cast<std::size_t>(d - owned_dof_begin())] = constrained_[d] ? 1.0 : 0.0;

@@ -93,18 +93,18 @@ class Assembler {
   Vec ghost_vec_ = nullptr;
   VecScatter scatter_ = nullptr;
   // Hessian assembly in coordinate form (MatSetPreallocationCOO / MatSetValuesCOO):
-  // one n x n block (column-major like Eigen) per distinct node list of the pieces,
-  // which every piece with that node list adds to, then the owned diagonals. PETSc
-  // sums repeated entries; index -1 entries are ignored.
+  // every piece's n x n block at a fixed offset, column-major like Eigen, then the
+  // constrained diagonals. PETSc sums repeated entries; index -1 entries are ignored.
   std::vector<PetscInt> coo_i_, coo_j_;
   std::vector<PetscScalar> coo_v_;
-  std::vector<std::vector<std::size_t>> coo_offset_;  // [term][piece] -> first value of its block
+  std::vector<std::vector<std::size_t>> coo_offset_;  // [term][piece] -> first value
   // Terms with sparse_pieces(): [term][piece] -> first entry in block_offset_[term],
   // which lists, for the piece's n x n node pairs (column-major), the first value
   // of the pair's shared 3 x 3 block (column-major).
   std::vector<std::vector<std::size_t>> block_first_;
   std::vector<std::vector<std::size_t>> block_offset_;
-  std::size_t coo_diagonal_ = 0;  // first constrained-diagonal value
+  std::vector<std::pair<std::size_t, std::size_t>> block_values_;  // each such term's [first, end) values
+  std::size_t coo_diagonal_ = 0;                                   // first constrained-diagonal value
 };
 
 }  // namespace morphfem

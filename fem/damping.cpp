@@ -43,7 +43,7 @@ double viscous_damping_kernel(const ShapeTable& table, const Eigen::MatrixXd& X,
   if (H) H->setZero(3 * n, 3 * n);
   const double a = 2.0 * eta / h, b = zeta / h;
   auto viscous_stress = [&](const Mat3& dE) -> Mat3 { return a * deviator(dE) + b * dE.trace() * Mat3::Identity(); };
-  Eigen::MatrixXd dN_dX;
+  Eigen::MatrixXd dN_dX, B;
   double energy = 0.0;
   for (size_t q = 0; q < table.points.size(); ++q) {
     const double dV = table.points[q].weight * physical_gradients(X, table.dN[q], dN_dX);
@@ -53,7 +53,8 @@ double viscous_damping_kernel(const ShapeTable& table, const Eigen::MatrixXd& X,
     energy += dV * (eta / h * deviator(dE).squaredNorm() + 0.5 * b * trace * trace);
     if (!g && !H) continue;
     const Mat3 S = viscous_stress(dE);
-    if (g) add_BtP(dN_dX, F * S, dV, *g);
+    deformation_gradient_map(dN_dX, B);  // dF/du
+    if (g) *g += dV * B.transpose() * flatten(F * S);
     if (H) {
       Tangent A;
       for (int k = 0; k < 3; ++k)
@@ -64,7 +65,7 @@ double viscous_damping_kernel(const ShapeTable& table, const Eigen::MatrixXd& X,
           const Mat3 dS = viscous_stress(0.5 * (FtdF + FtdF.transpose()));
           A.col(3 * k + L) = flatten(dF * S + F * dS);
         }
-      add_BtAB(dN_dX, A, dV, *H);
+      H->noalias() += dV * B.transpose() * A * B;
     }
   }
   return energy;

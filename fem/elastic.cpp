@@ -4,7 +4,6 @@
 #include <limits>
 #include <stdexcept>
 
-#include "fem/kinematics.h"
 #include "fem/mean_dilatation.h"
 
 namespace morphfem {
@@ -60,7 +59,7 @@ double ElasticTerm::piece(int k, const PieceState& s, Eigen::VectorXd* g, Eigen:
   const int n = static_cast<int>(s.X.rows());
   if (g) g->setZero(3 * n);
   if (H) H->setZero(3 * n, 3 * n);
-  Eigen::MatrixXd dN_dX;
+  Eigen::MatrixXd dN_dX, B;
   double energy = 0.0;
   Mat3 P;
   Tangent A;
@@ -82,8 +81,12 @@ double ElasticTerm::piece(int k, const PieceState& s, Eigen::VectorXd* g, Eigen:
       if (H) A = det_G * column_scale.asDiagonal() * A * column_scale.asDiagonal();
     }
     energy += dV * W;
-    if (g) add_BtP(dN_dX, P, dV, *g);
-    if (H) add_BtAB(dN_dX, A, dV, *H);
+    deformation_gradient_map(dN_dX, B);
+    if (g) {
+      const Eigen::Matrix<double, 3, 3, Eigen::RowMajor> P_rows = P;  // flatten as 3*i + J
+      *g += dV * B.transpose() * Eigen::Map<const Eigen::Matrix<double, 9, 1>>(P_rows.data());
+    }
+    if (H) H->noalias() += dV * B.transpose() * A * B;
   }
   return energy;
 }

@@ -44,10 +44,6 @@ class EnergyTerm {
   // scale with the coupled node pairs, not with the candidates. Same matrix.
   virtual bool sparse_pieces() const { return false; }
 
-  // True if the energy is linear in u (dead loads), so its Hessian is zero: the
-  // assembler leaves the term out of the Hessian's sweep and pattern.
-  virtual bool zero_hessian() const { return false; }
-
   // Terms that project their Hessian to PSD (per-pair barrier Hessians, friction's
   // static-to-kinetic drop) give the exact Hessian while `exact` is set. The solver's
   // adaptive projection sets it once Newton takes full steps: near a minimum the

@@ -24,36 +24,6 @@ Volumetric volumetric(double kappa, double J) {
           0.5 * kappa * (1.0 + 1.0 / (J * J))};
 }
 
-void add_BtP(const Eigen::MatrixXd& dN_dX, const Mat3& P, double w, Eigen::VectorXd& g) {
-  const int n = static_cast<int>(dN_dX.rows());
-  for (int a = 0; a < n; ++a) {
-    const Eigen::Vector3d dN = dN_dX.row(a).transpose();
-    g.segment<3>(3 * a).noalias() += w * (P * dN);
-  }
-}
-
-void add_BtAB(const Eigen::MatrixXd& dN_dX, const Tangent& A, double w, Eigen::MatrixXd& H) {
-  const int n = static_cast<int>(dN_dX.rows());
-  constexpr int kMaxNodes = 10;  // P2 tetrahedra; larger cells take the heap
-  using Columns = Eigen::Matrix<double, 9, Eigen::Dynamic, 0, 9, 3 * kMaxNodes>;
-  // AB(:, 3b+k) = sum_L A(:, 3k+L) dN_b/dX_L: column (b, k) of A B.
-  Columns AB(9, 3 * n);
-  for (int b = 0; b < n; ++b) {
-    const Eigen::Vector3d dN = w * dN_dX.row(b).transpose();
-    for (int k = 0; k < 3; ++k) AB.col(3 * b + k).noalias() = A.middleCols<3>(3 * k) * dN;
-  }
-  // H(3a+i, 3b+k) = sum_J dN_a/dX_J AB(3i+J, 3b+k); the lower triangle by symmetry.
-  for (int a = 0; a < n; ++a) {
-    const Eigen::RowVector3d dN = dN_dX.row(a);
-    for (int i = 0; i < 3; ++i) {
-      const int row = 3 * a + i;
-      for (int col = 0; col <= row; ++col) H(row, col) += dN.dot(AB.block<3, 1>(3 * i, col));
-    }
-  }
-  for (int col = 1; col < 3 * n; ++col)
-    for (int row = 0; row < col; ++row) H(row, col) = H(col, row);
-}
-
 void det_derivatives(const Mat3& F, double J, Vec9& gJ, Tangent* HJ) {
   const Mat3 Finv = F.inverse();
   for (int i = 0; i < 3; ++i)

@@ -62,16 +62,6 @@ struct IsochoricDerivatives {
   double W11 = 0, W12 = 0, W22 = 0;
 };
 
-// The element gradient and Hessian of an energy density W(F) at one quadrature
-// point, through F = I + u^T dN/dX without forming the 9 x 3n map B = dF/du
-// (B(3i+J, 3b+k) = delta_ik dN_b/dX_J, fem/element.h), w = weight * det J0 [m^3]:
-//   g(3a+i)        += w sum_J P_iJ dN_a/dX_J                          (B^T P)     [N]
-//   H(3a+i, 3b+k)  += w sum_{J,L} dN_a/dX_J A(3i+J, 3k+L) dN_b/dX_L   (B^T A B)   [N/m]
-// B^T A B costs 3n (27 + 9n) products this way against 9n (9 + 3n) with B dense;
-// H must be symmetric-sized 3n x 3n and A symmetric (every tangent here is).
-void add_BtP(const Eigen::MatrixXd& dN_dX, const Mat3& P, double w, Eigen::VectorXd& g);
-void add_BtAB(const Eigen::MatrixXd& dN_dX, const Tangent& A, double w, Eigen::MatrixXd& H);
-
 // Chain rule for W(F) = Wiso(Ibar1, Ibar2) + U(J):
 //   P = W^_I1 dI1/dF + W^_I2 dI2/dF + W^_J dJ/dF,
 //   A = sum_a W^_a d^2 y_a/dF^2 + G W^_yy G^T,  y = (I1, I2, J), G = [dy_a/dF],

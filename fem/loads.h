@@ -25,7 +25,6 @@ class DeadLoadTerm : public EnergyTerm {
   void piece_nodes(int k, std::vector<int>& nodes) const override;
   double piece(int k, const PieceState& s, Eigen::VectorXd* g, Eigen::MatrixXd* H) const override;
   void set_time(double t) override;
-  bool zero_hessian() const override { return true; }
 
  protected:
   enum class Entity { cell, face };

@@ -7,7 +7,6 @@
 #include <stdexcept>
 
 #include "core/errors.h"
-#include "fem/kinematics.h"
 
 namespace morphfem {
 
@@ -48,7 +47,7 @@ double MeanDilatationTerm::piece(int k, const PieceState& s, Eigen::VectorXd* g,
   const double inf = std::numeric_limits<double>::infinity();
   if (g) g->setZero(3 * n);
   if (H) H->setZero(3 * n, 3 * n);
-  Eigen::MatrixXd dN_dX;
+  Eigen::MatrixXd dN_dX, B;
   double energy = 0.0;
   Mat3 P;
   Tangent A;
@@ -62,8 +61,12 @@ double MeanDilatationTerm::piece(int k, const PieceState& s, Eigen::VectorXd* g,
     material.evaluate_isochoric(F, W, P, H ? &A : nullptr);
     energy += dV * W;
     if (!g && !H) continue;
-    if (g) add_BtP(dN_dX, P, dV, *g);
-    if (H) add_BtAB(dN_dX, A, dV, *H);
+    deformation_gradient_map(dN_dX, B);
+    if (g) {
+      const Eigen::Matrix<double, 3, 3, Eigen::RowMajor> P_rows = P;  // flattened as 3*i + J
+      *g += dV * B.transpose() * Eigen::Map<const Eigen::Matrix<double, 9, 1>>(P_rows.data());
+    }
+    if (H) H->noalias() += dV * B.transpose() * A * B;
   }
 
   // ---- Volumetric part: V_e U(Theta_e), Theta_e = v_e / V_e.
