@@ -54,9 +54,12 @@ std::vector<std::string> names_of(const Map& registry) {
 }
 
 using K = KeyType;
+using Keys = std::vector<SceneKey>;
+
+void append(Keys& t, const Keys& keys) { t.insert(t.end(), keys.begin(), keys.end()); }
 
 // A cavity's wall: the keys loads.cavities, gas_cavities and volume_cavities share.
-void add_wall(std::vector<SceneKey>& t, const std::string& list, const std::string& name_default) {
+void add_wall(Keys& t, const std::string& list, const std::string& name_default) {
   t.push_back(key(list + ".name", K::text, "", name_default, "the cavity's name in results"));
   t.push_back(key(list + ".surfaces", K::names, "", "required", "surface regions that enclose the cavity"));
   t.push_back(key(list + ".volume_axes", K::axes, "", "[x, y, z]",
@@ -66,10 +69,10 @@ void add_wall(std::vector<SceneKey>& t, const std::string& list, const std::stri
                   "the volume axes are the other two"));
 }
 
-std::vector<SceneKey> build_table() {
-  std::vector<SceneKey> t = {
+// The scene's name and its body: geometry or mesh, materials, membranes, boundary conditions.
+void add_body_keys(Keys& t) {
+  const Keys keys = {
       key("name", K::text, "", "scene", "the scene's name: results are NAME.xdmf, NAME.h5"),
-      // Body.
       key("geometry", K::parameters, "", "", "a built-in geometry (give geometry or mesh)"),
       key("geometry.type", K::text, "", "required", "the geometry builder (mesh/geometry.h)"),
       key("geometry.<parameter>", K::parameters, "", "",
@@ -90,18 +93,19 @@ std::vector<SceneKey> build_table() {
       key("boundary.surface", K::text, "", "required", "the surface region"),
       key("boundary.fix", K::axes, "", "", "components held at zero (give fix or displacement)"),
       key("boundary.displacement", K::vector3, "[m]", "", "the final displacement, ramped linearly over the run"),
-      // Loads.
-      key("loads", K::mapping, "", "", "external loads"),
-      key("loads.gravity", K::vector3, "[m/s^2]", "[0, 0, 0]",
-          "gravitational acceleration; needs each material's density [kg/m^3]"),
-      key("loads.cavities", K::list, "", "", "cavities under a prescribed pressure"),
   };
+  append(t, keys);
+}
+
+// The cavity lists: prescribed pressure, gas fed through a valve, prescribed volume.
+void add_cavity_keys(Keys& t) {
+  t.push_back(key("loads.cavities", K::list, "", "", "cavities under a prescribed pressure"));
   add_wall(t, "loads.cavities", "cavity0, cavity1, ...");
   t.push_back(key("loads.cavities.pressure", K::time_function, "[Pa]", "required", "the gauge pressure"));
   t.push_back(key("loads.gas_cavities", K::list, "", "",
                   "cavities of isothermal ideal gas fed through a valve (actuation/gas_cavity.h)"));
   add_wall(t, "loads.gas_cavities", "gas0, gas1, ...");
-  const std::vector<SceneKey> gas = {
+  const Keys gas = {
       key("loads.gas_cavities.symmetry_factor", K::number, "[-]", "1", "copies of the meshed part in the whole cavity",
           kPositive),
       key("loads.gas_cavities.temperature", K::number, "[K]", "293.15", "the gas temperature", kPositive),
@@ -111,17 +115,31 @@ std::vector<SceneKey> build_table() {
       key("loads.gas_cavities.conductance", K::coefficient, "[mol/(s Pa)]", "0", "the valve's conductance", {}, ">= 0"),
       key("loads.gas_cavities.vacuum_conductance", K::coefficient, "[mol/(s Pa)]", "conductance",
           "the conductance while the supply pressure is below 0", {}, ">= 0"),
-      key("loads.volume_cavities", K::list, "", "",
-          "cavities of prescribed volume; the pressure is the constraint's multiplier"),
   };
-  t.insert(t.end(), gas.begin(), gas.end());
+  append(t, gas);
+  t.push_back(key("loads.volume_cavities", K::list, "", "",
+                  "cavities of prescribed volume; the pressure is the constraint's multiplier"));
   add_wall(t, "loads.volume_cavities", "volume0, volume1, ...");
-  const std::vector<SceneKey> rest = {
+  const Keys volume = {
       key("loads.volume_cavities.volume_ratio", K::table, "[-]", "required",
           "the prescribed volume over the reference volume, V*/V_ref", {}, "> 0"),
       key("loads.volume_cavities.penalty_modulus", K::number, "[Pa]", "required",
           "the volume constraint's penalty modulus", kPositive),
       key("loads.volume_cavities.tolerance", K::number, "[-]", "1e-06", "|V - V*| / V* allowed", kPositive),
+  };
+  append(t, volume);
+}
+
+// External loads: gravity, the cavities, tractions, pulls.
+void add_load_keys(Keys& t) {
+  const Keys loads = {
+      key("loads", K::mapping, "", "", "external loads"),
+      key("loads.gravity", K::vector3, "[m/s^2]", "[0, 0, 0]",
+          "gravitational acceleration; needs each material's density [kg/m^3]"),
+  };
+  append(t, loads);
+  add_cavity_keys(t);
+  const Keys surface_loads = {
       key("loads.tractions", K::list, "", "", "dead surface loads"),
       key("loads.tractions.surface", K::text, "", "required", "the surface region"),
       key("loads.tractions.traction", K::vector3, "[Pa]", "required", "the traction (force per reference area)"),
@@ -131,7 +149,13 @@ std::vector<SceneKey> build_table() {
       key("loads.pulls.stiffness", K::number, "[N/m]", "required", "the spring's stiffness", kPositive),
       key("loads.pulls.velocity", K::vector3, "[m/s]", "required", "the machine's velocity", {}, "not zero"),
       key("loads.pulls.start", K::number, "[s]", "0", "when the machine starts"),
-      // Solver.
+  };
+  append(t, surface_loads);
+}
+
+// Time stepping and Newton's method.
+void add_solver_keys(Keys& t) {
+  const Keys keys = {
       key("solver", K::mapping, "", "", "time stepping and Newton's method (fem/solver.h)"),
       key("solver.end_time", K::number, "[s]", "1", "the run's end (pseudo-time for a quasi-static scene)", kPositive),
       key("solver.initial_step", K::number, "[s]", "0.1", "the first step (at most end_time)", kPositive),
@@ -153,14 +177,26 @@ std::vector<SceneKey> build_table() {
              "the elastic element formulation (fem/elastic.h)"),
       choice("solver.hessian_projection", "adaptive", {"adaptive", "always"},
              "adaptive: the exact Hessian after a full Newton step, else the projected one; always: projected"),
-      // Output.
+  };
+  append(t, keys);
+}
+
+// Results on disk.
+void add_output_keys(Keys& t) {
+  const Keys keys = {
       key("output", K::mapping, "", "", "results on disk (none without output.directory)"),
       key("output.directory", K::text, "", "", "the results' folder (XDMF + HDF5, summary.json)"),
       key("output.every", K::integer, "[-]", "1", "write every n-th step", at_least(1)),
       key("output.checkpoint_s", K::number, "[s]", "600",
           "wall time between checkpoints (0: only the final one); `run --resume` continues from the last",
           kNonNegative),
-      // Dynamics.
+  };
+  append(t, keys);
+}
+
+// Inertia and damping.
+void add_dynamics_keys(Keys& t) {
+  const Keys keys = {
       key("dynamics", K::mapping, "", "", "inertia and damping (absent: quasi-static)"),
       choice("dynamics.scheme", "newmark", names_of(time_schemes()), "the time integrator (fem/inertia.h)"),
       key("dynamics.lumped", K::number, "[-]", "0", "nonzero: lumped (diagonal) mass instead of consistent"),
@@ -171,7 +207,13 @@ std::vector<SceneKey> build_table() {
       key("dynamics.shear_viscosity", K::number, "[Pa s]", "0", "Kelvin-Voigt shear viscosity", kNonNegative),
       key("dynamics.bulk_viscosity", K::number, "[Pa s]", "0", "Kelvin-Voigt bulk viscosity", kNonNegative),
       key("dynamics.initial_velocity", K::vector3, "[m/s]", "[0, 0, 0]", "every node's velocity at t = 0"),
-      // Contact.
+  };
+  append(t, keys);
+}
+
+// Ground contact, friction, the lattice floor, self-contact.
+void add_contact_keys(Keys& t) {
+  const Keys keys = {
       key("contact", K::mapping, "", "", "contact and friction"),
       key("contact.ground", K::mapping, "", "", "a rigid plane under barrier contact (contact/ground.h)"),
       key("contact.ground.point", K::vector3, "[m]", "[0, 0, 0]", "a point of the plane"),
@@ -217,7 +259,13 @@ std::vector<SceneKey> build_table() {
           "largest trust radius of a far node; below half the candidate radius: half of it", kNonNegative),
       key("contact.self.start", K::number, "[s]", "", "the barrier acts from this time on (absent: from the start)"),
       key("contact.self.project_hessian", K::boolean, "", "true", "project each pair's barrier Hessian to PSD"),
-      // Actuation.
+  };
+  append(t, keys);
+}
+
+// A schedule played through bladders or voxel growth, with foot friction.
+void add_actuation_keys(Keys& t) {
+  const Keys keys = {
       key("actuation", K::mapping, "", "",
           "a schedule played through bladder cavities or voxel growth, with foot friction"),
       key("actuation.schedule", K::schedule, "", "required",
@@ -249,7 +297,13 @@ std::vector<SceneKey> build_table() {
           "the rigid chamber's time constant V_ref / (C R T) (give fill_time_s or conductance)", kPositive),
       key("actuation.valves.conductance", K::calibrated, "[mol/(s Pa)]", "", "the valve's conductance C", kPositive),
       key("actuation.valves.temperature", K::calibrated, "[K]", "293.15", "the gas temperature", kPositive),
-      // Environment.
+  };
+  append(t, keys);
+}
+
+// The study's ground.
+void add_environment_keys(Keys& t) {
+  const Keys keys = {
       key("environment", K::mapping, "", "",
           "the study's ground: gravity rotated by the slope (instead of loads.gravity)"),
       key("environment.slope_deg", K::number, "[deg]", "0", "the slope", between(-90, 90)),
@@ -258,12 +312,26 @@ std::vector<SceneKey> build_table() {
       key("environment.gravity", K::number, "[m/s^2]", "9.80665", "gravity's magnitude", kNonNegative),
       key("environment.body_length", K::number, "[m]", "the mesh's y extent", "speeds are in body lengths per second",
           kPositive),
-      // A calibrated value wherever one is allowed.
+  };
+  append(t, keys);
+}
+
+// A calibrated value, wherever one is allowed.
+void add_calibrated_value_keys(Keys& t) {
+  const Keys keys = {
       key("(calibrated value).calibration", K::file, "", "required",
           "a calibration file (core/calibration_file.h), e.g. written by `morphfem calibrate`"),
       key("(calibrated value).parameter", K::text, "", "required", "the parameter's name in that file"),
   };
-  t.insert(t.end(), rest.begin(), rest.end());
+  append(t, keys);
+}
+
+// Every key, section by section (the order of docs/scene-keys.md).
+std::vector<SceneKey> build_table() {
+  Keys t;
+  for (auto add : {add_body_keys, add_load_keys, add_solver_keys, add_output_keys, add_dynamics_keys, add_contact_keys,
+                   add_actuation_keys, add_environment_keys, add_calibrated_value_keys})
+    add(t);
   return t;
 }
 
