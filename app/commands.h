@@ -5,6 +5,7 @@
 #include <mpi.h>
 
 #include <functional>
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -13,6 +14,9 @@ namespace morphfem {
 int run_command(const std::vector<std::string>& args, MPI_Comm comm);
 int verify_command(const std::vector<std::string>& args, MPI_Comm comm);
 int fit_materials_command(const std::vector<std::string>& args);
+// fit-materials reading `default_data_dir` unless --data-dir is given, printing to `out`;
+// --help prints the usage and returns 0.
+int fit_materials_main(const std::vector<std::string>& args, const std::string& default_data_dir, std::ostream& out);
 int robot_command(const std::vector<std::string>& args, MPI_Comm comm);
 int search_command(const std::vector<std::string>& args, MPI_Comm comm);
 int calibrate_command(const std::vector<std::string>& args, MPI_Comm comm);

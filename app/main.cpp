@@ -13,7 +13,6 @@
 #include "app/commands.h"
 #include "core/errors.h"
 #include "core/paths.h"
-#include "fem/material_fit.h"
 #include "hardware/cli.h"
 
 namespace {

@@ -11,25 +11,13 @@
 #include <functional>
 #include <iomanip>
 #include <limits>
-#include <optional>
 #include <sstream>
 
-#include "core/command_line.h"
 #include "core/errors.h"
 #include "core/json.h"
 #include "core/test_machine_export.h"
 
 namespace morphfem {
-
-namespace {
-
-std::optional<double> parse_number(const std::string& s) {
-  double v;
-  if (!parse_export_number(s, true, v)) return std::nullopt;
-  return v;
-}
-
-}  // namespace
 
 TensileTest tensile_test_from_export(const SpecimenExport& s) {
   TensileTest test;
@@ -424,7 +412,7 @@ void select_strain_range(const TensileTest& test, double max_strain, std::vector
 }
 
 // ---------------------------------------------------------------------------------
-// Command line.
+// Every file of a directory, and what is printed of the fits.
 
 std::vector<MaterialFits> fit_material_directory(const std::string& data_dir, double max_strain) {
   namespace fs = std::filesystem;
@@ -449,32 +437,6 @@ std::vector<MaterialFits> fit_material_directory(const std::string& data_dir, do
 }
 
 namespace {
-
-// `morphfem fit-materials` options; --help prints the usage and returns nullopt.
-std::optional<FitMaterialsOptions> parse_fit_materials_args(const std::vector<std::string>& args,
-                                                            const std::string& default_data_dir, std::ostream& out) {
-  CommandLine cl("morphfem fit-materials", "[--data-dir DIR] [--max-strain 2.0] [--json] [--curves FILE.csv]",
-                 "Fits neo-Hookean, Yeoh and Ogden (N = 1, 2, 3) laws to every *.csv tensile-test export in a "
-                 "directory and prints a table per material and model, or JSON.");
-  cl.value("--data-dir", "DIR", "the tensile-test exports (default: the shared materials data)")
-      .value("--max-strain", "STRAIN",
-             "fit the points with 0 < engineering strain <= STRAIN, in (0.05, 20] (default 2.0)")
-      .flag("--json", "print JSON instead of the table")
-      .value("--curves", "FILE.csv", "write data and fitted curves as CSV (for scripts/plot_material_fit.py)");
-  if (!cl.parse(args, out)) return std::nullopt;
-  FitMaterialsOptions o;
-  o.data_dir = cl.get("--data-dir", default_data_dir);
-  if (cl.has("--max-strain")) {
-    const std::string v = cl.get("--max-strain", "");
-    const auto x = parse_number(v);
-    if (!x || *x <= 0.05 || *x > 20.0)
-      throw InputError("fit-materials", "--max-strain '" + v + "' must be an engineering strain in (0.05, 20]");
-    o.max_strain = *x;
-  }
-  o.json = cl.has("--json");
-  o.curves_file = cl.get("--curves", "");
-  return o;
-}
 
 // One material's fits as JSON: file, conversion, range and per model the coefficients,
 // RMS [Pa], R^2, small-strain mu [Pa], stability and convergence.
@@ -577,11 +539,6 @@ int fit_materials(const FitMaterialsOptions& o, std::ostream& out) {
   }
   if (!o.curves_file.empty()) write_file_atomic(o.curves_file, curves.str());
   return 0;
-}
-
-int fit_materials_main(const std::vector<std::string>& args, const std::string& default_data_dir, std::ostream& out) {
-  const std::optional<FitMaterialsOptions> options = parse_fit_materials_args(args, default_data_dir, out);
-  return options ? fit_materials(*options, out) : 0;
 }
 
 }  // namespace morphfem

@@ -86,10 +86,11 @@ struct MaterialFits {
 };
 std::vector<MaterialFits> fit_material_directory(const std::string& data_dir, double max_strain);
 
-// What `morphfem fit-materials` does: fits every *.csv in `data_dir` and prints a
-// table per material and model (coefficients, RMS error in kPa, range used), or JSON
-// with `json`; a non-empty `curves_file` gets data and fitted curves as CSV (for
-// scripts/plot_material_fit.py). Returns 0; bad data throw InputError.
+// Fits every *.csv in `data_dir` and prints a table per material and model
+// (coefficients, RMS error in kPa, range used), or JSON with `json`; a non-empty
+// `curves_file` gets data and fitted curves as CSV (for scripts/plot_material_fit.py).
+// Returns 0; bad data throw InputError. (`morphfem fit-materials`, app/, reads these
+// options from its command line.)
 struct FitMaterialsOptions {
   std::string data_dir;
   double max_strain = 2.0;  // engineering strain [-], in (0.05, 20]
@@ -97,12 +98,5 @@ struct FitMaterialsOptions {
   std::string curves_file;
 };
 int fit_materials(const FitMaterialsOptions& options, std::ostream& out = std::cout);
-
-// `morphfem fit-materials [--data-dir DIR] [--max-strain 2.0] [--json] [--curves FILE]`:
-// the arguments parsed with core/command_line.h (DIR defaults to `default_data_dir`),
-// then fit_materials. --help prints the usage and returns 0; bad arguments or data
-// throw InputError.
-int fit_materials_main(const std::vector<std::string>& args, const std::string& default_data_dir = "",
-                       std::ostream& out = std::cout);
 
 }  // namespace morphfem

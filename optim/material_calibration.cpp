@@ -17,25 +17,25 @@ namespace morphfem {
 
 int calibrate_materials(const MaterialCalibrationOptions& o) {
   const std::string& dir = o.out_dir;
-  std::vector<std::string> pass = {"--data-dir", o.data_dir};
-  if (!o.max_strain.empty()) pass.insert(pass.end(), {"--max-strain", o.max_strain});
-  const std::string& default_dir = o.data_dir;
-  if (dir.empty()) return fit_materials_main(pass, default_dir, std::cout);
-  std::filesystem::create_directories(dir);
-  const std::string curves = (std::filesystem::path(dir) / "material_fit_curves.csv").string();
-  std::vector<std::string> with_json = pass;
-  with_json.insert(with_json.end(), {"--json", "--curves", curves});
-  std::ostringstream json;
-  fit_materials_main(with_json, default_dir, json);
-  write_file_atomic((std::filesystem::path(dir) / "material_fit.json").string(), json.str());
-  fit_materials_main(pass, default_dir, std::cout);
-  const std::string png = (std::filesystem::path(dir) / "material_fit.png").string();
-  if (run_plot_script("plot_calibration.py", {"materials", curves, png}, "the calibration"))
-    std::cout << "plot: " << png << "\n";
-  // The calibration file scenes load: {calibration: materials.yaml, parameter: dragonskin10.yeoh.c1}.
   const std::string& data_dir = o.data_dir;
   const double max_strain =
       o.max_strain.empty() ? 2.0 : number_option("materials", "--max-strain", o.max_strain, 0.05, 20);
+  FitMaterialsOptions table;
+  table.data_dir = data_dir;
+  table.max_strain = max_strain;
+  if (dir.empty()) return fit_materials(table, std::cout);
+  std::filesystem::create_directories(dir);
+  FitMaterialsOptions with_json = table;
+  with_json.json = true;
+  with_json.curves_file = (std::filesystem::path(dir) / "material_fit_curves.csv").string();
+  std::ostringstream json;
+  fit_materials(with_json, json);
+  write_file_atomic((std::filesystem::path(dir) / "material_fit.json").string(), json.str());
+  fit_materials(table, std::cout);
+  const std::string png = (std::filesystem::path(dir) / "material_fit.png").string();
+  if (run_plot_script("plot_calibration.py", {"materials", with_json.curves_file, png}, "the calibration"))
+    std::cout << "plot: " << png << "\n";
+  // The calibration file scenes load: {calibration: materials.yaml, parameter: dragonskin10.yeoh.c1}.
   Calibration cal;
   cal.kind = "materials";
   cal.command = "morphfem calibrate materials";

@@ -171,7 +171,7 @@ TEST_F(MaterialFitFiles, RejectsMissingColumnsAndBadNumbers) {
   expect_error_at((dir_ / "absent.csv").string(), (dir_ / "absent.csv").string(), "cannot open");
 }
 
-TEST_F(MaterialFitFiles, CommandFitsEveryFileInTheDirectory) {
+TEST_F(MaterialFitFiles, FitsEveryFileInTheDirectory) {
   std::ostringstream csv;
   csv << kHeader << "Time (s);Engineering Strain (%);Engineering Stress (kPa)\n";
   for (int i = 1; i <= 60; ++i) {
@@ -179,22 +179,25 @@ TEST_F(MaterialFitFiles, CommandFitsEveryFileInTheDirectory) {
     csv << 0.1 * i << ";" << 5.0 * i << ";" << uniaxial_stress_yeoh(l, 20e3, 2e3, -50.0) / 1e3 << "\n";
   }
   write("synthetic.csv", csv.str());
+  FitMaterialsOptions options;
+  options.data_dir = dir_.string();
+  options.max_strain = 2.0;
   std::ostringstream out;
-  EXPECT_EQ(fit_materials_main({"--max-strain", "2.0"}, dir_.string(), out), 0);
+  EXPECT_EQ(fit_materials(options, out), 0);
   EXPECT_NE(out.str().find("TestRubber"), std::string::npos) << out.str();
   EXPECT_NE(out.str().find("c1 = 20000"), std::string::npos) << out.str();
   EXPECT_NE(out.str().find("40 points"), std::string::npos) << out.str();
 
+  options.json = true;
+  options.curves_file = (dir_ / "curves.out").string();
   std::ostringstream json;
-  fit_materials_main({"--json", "--data-dir", dir_.string(), "--curves", (dir_ / "curves.out").string()}, "", json);
+  fit_materials(options, json);
   EXPECT_NE(json.str().find("\"model\": \"yeoh\""), std::string::npos) << json.str();
   EXPECT_TRUE(std::filesystem::exists(dir_ / "curves.out"));
 
   std::ostringstream ignored;
-  EXPECT_THROW(fit_materials_main({"--max-strian", "2"}, dir_.string(), ignored), InputError);
-  EXPECT_THROW(fit_materials_main({"--max-strain"}, dir_.string(), ignored), InputError);
-  EXPECT_THROW(fit_materials_main({"--max-strain", "x"}, dir_.string(), ignored), InputError);
-  EXPECT_THROW(fit_materials_main({}, (dir_ / "nowhere").string(), ignored), InputError);
+  options.data_dir = (dir_ / "nowhere").string();
+  EXPECT_THROW(fit_materials(options, ignored), InputError);
 }
 
 }  // namespace
