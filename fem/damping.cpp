@@ -72,8 +72,10 @@ double viscous_damping_kernel(const ShapeTable& table, const Eigen::MatrixXd& X,
 }
 
 DampingTerm::DampingTerm(const Mesh& mesh, const Partition& partition, int rank, std::vector<double> shear_viscosity,
-                         std::vector<double> bulk_viscosity, TimeScheme scheme, int quadrature_degree)
-    : mesh_(mesh), scheme_(scheme) {
+                         std::vector<double> bulk_viscosity, std::shared_ptr<const TimeIntegrator> integrator,
+                         int quadrature_degree)
+    : mesh_(mesh), integrator_(std::move(integrator)) {
+  if (!integrator_) throw std::invalid_argument("damping: needs the time integrator");
   for (int c = 0; c < mesh.n_cells(); ++c) {
     if (partition.cell_part[c] != rank) continue;
     const int region = mesh.cell_region[c];
@@ -101,7 +103,7 @@ double DampingTerm::piece(int k, const PieceState& s, Eigen::VectorXd* g, Eigen:
     if (H) H->setZero(3 * n, 3 * n);
     return 0.0;
   }
-  return viscous_damping_kernel(table_, s.X, s.u, E_star_[k], eta_[k], zeta_[k], h_ / kappa_, g, H);
+  return viscous_damping_kernel(table_, s.X, s.u, E_star_[k], eta_[k], zeta_[k], rule_.h / rule_.kappa, g, H);
 }
 
 namespace {
@@ -122,34 +124,20 @@ void piece_state(const Mesh& mesh, const Assembler& assembler, const std::vector
 }  // namespace
 
 void DampingTerm::begin_step(Assembler& assembler, Vec u0, double t0, double t1) {
-  h_ = t1 - t0;
-  if (!(h_ > 0)) throw std::invalid_argument("damping: the time step must be positive");
+  if (!(t1 - t0 > 0)) throw std::invalid_argument("damping: the time step must be positive");
+  rule_ = integrator_->rate_rule(t1 - t0, h_prev_, steps_done_ > 0);
   const std::vector<double>& local = assembler.gather(u0);
   E_n_.resize(cells_.size());
   E_star_.resize(cells_.size());
   std::vector<int> nodes;
   Eigen::MatrixXd X, u;
-  const bool first = steps_done_ == 0 || scheme_ == TimeScheme::implicit_euler;
-  trapezoidal_ = !first && (scheme_ == TimeScheme::newmark || h_ > kBdf2MaxStepRatio * h_prev_);
-  double alpha0 = 1.0, alpha1 = -1.0, alpha2 = 0.0;
-  if (first) {
-    kappa_ = 1.0;
-  } else if (trapezoidal_) {  // newmark, or a bdf2 step that grows too much (as in InertiaTerm)
-    kappa_ = 2.0;
-  } else {
-    const double w = h_ / h_prev_;
-    alpha0 = (1 + 2 * w) / (1 + w), alpha1 = -(1 + w), alpha2 = w * w / (1 + w);
-    kappa_ = alpha0;
-  }
   for (int k = 0; k < n_pieces(); ++k) {
     piece_nodes(k, nodes);
     piece_state(mesh_, assembler, local, nodes, X, u);
     E_n_[k] = green_lagrange_at_points(table_, X, u);
     E_star_[k] = E_n_[k];
-    if (first) continue;
-    for (size_t q = 0; q < E_n_[k].size(); ++q)
-      E_star_[k][q] = trapezoidal_ ? Mat3(E_n_[k][q] + 0.5 * h_ * Edot_n_[k][q])
-                                   : Mat3(-(alpha1 * E_n_[k][q] + alpha2 * E_nm1_[k][q]) / alpha0);
+    if (!rule_.uses_history()) continue;
+    for (size_t q = 0; q < E_n_[k].size(); ++q) E_star_[k][q] = rule_.anchor(E_n_[k][q], E_nm1_[k][q], Edot_n_[k][q]);
   }
 }
 
@@ -166,9 +154,10 @@ void DampingTerm::end_step(Assembler& assembler, Vec u1, double /*t1*/) {
     const std::vector<Mat3> E1 = green_lagrange_at_points(table_, X, u);
     std::vector<Mat3> Edot1(E1.size());
     for (size_t q = 0; q < E1.size(); ++q) {
-      Edot1[q] = kappa_ / h_ * (E1[q] - E_star_[k][q]);
-      // Viscous stress of the rate that does the work: S_v(Edot) = 2 eta dev Edot + zeta tr(Edot) I.
-      const Mat3 rate = trapezoidal_ ? Mat3(0.5 * (Edot_n_[k][q] + Edot1[q])) : Edot1[q];
+      Edot1[q] = rule_.rate(E1[q], E_star_[k][q]);
+      // Viscous stress of the rate that does the work: S_v(Edot) = 2 eta dev Edot + zeta tr(Edot) I
+      // (Edot_n exists where the rule uses the history).
+      const Mat3 rate = rule_.uses_history() ? rule_.work_rate(Edot_n_[k][q], Edot1[q]) : Edot1[q];
       const Mat3 S = 2 * eta_[k] * deviator(rate) + zeta_[k] * rate.trace() * Mat3::Identity();
       const double dV = table_.points[q].weight * physical_gradients(X, table_.dN[q], dN_dX);
       sum += dV * (S.array() * (E1[q] - E_n_[k][q]).array()).sum();
@@ -178,7 +167,7 @@ void DampingTerm::end_step(Assembler& assembler, Vec u1, double /*t1*/) {
   }
   MPI_Allreduce(&sum, &last_dissipated_, 1, MPI_DOUBLE, MPI_SUM, assembler.comm());
   total_dissipated_ += last_dissipated_;
-  h_prev_ = h_;
+  h_prev_ = rule_.h;
   ++steps_done_;
 }
 

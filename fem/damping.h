@@ -18,33 +18,30 @@
 // eta = G tan(delta) / omega, e.g. G = 0.1 MPa, tan(delta) = 0.1 at 5 Hz gives
 // eta ~ 300 Pa s.
 //
-// Time discretisation. Over the step t_n -> t_n + h the strain rate at the end
-// of the step is discretised with the same scheme as the inertia (so the viscous
-// force enters the same end-of-step equilibrium as M a_{n+1}):
-//   Edot(u) = kappa/h (E(u) - E*)
-//   implicit_euler: kappa = 1,      E* = E_n
-//   newmark (trapezoidal, beta = 1/4, gamma = 1/2): kappa = 2, E* = E_n + h/2 Edot_n
-//   bdf2 (variable step, w = h/h_{n-1}): kappa = alpha0 = (1 + 2w)/(1 + w),
-//        E* = -(alpha1 E_n + alpha2 E_{n-1})/alpha0, alpha1 = -(1 + w), alpha2 = w^2/(1 + w)
-// The first step (no Edot_n, E_{n-1} yet) is implicit Euler for every scheme; a
-// bdf2 step longer than kBdf2MaxStepRatio times the last one is trapezoidal.
+// Time discretisation. The strain rate at the end of the step t_n -> t_n + h is
+// the time integrator's rate of E (RateRule, fem/time_integrator.h), so that the
+// viscous force enters the same end-of-step equilibrium as M a_{n+1}:
+//   Edot(u) = kappa/h (E(u) - E*),  E* from E_n, E_{n-1} and Edot_n:
+// backward (kappa = 1, E* = E_n) at the first step, which has no Edot_n yet, and with
+// implicit_euler; trapezoidal with newmark; bdf2 with bdf2.
 // Incremental potential (dE = E(u) - E*, reference volume):
 //   D(u) = h/kappa int R(Edot) dV = kappa/h int [ eta |dev dE|^2 + zeta/2 (tr dE)^2 ] dV   [J]
 // with R = eta |dev Edot|^2 + zeta/2 (tr Edot)^2, so dD/dE = S_v(Edot) and dD/dF = F S_v
 // (first Piola-Kirchhoff viscous stress): the gradient is the viscous nodal force.
 // Energy dissipated by the step (>= 0), accumulated in end_step:
-//   implicit_euler, bdf2:  W = int S_v(Edot_{n+1}) : (E_{n+1} - E_n) dV
-//   newmark:               W = int S_v((Edot_n + Edot_{n+1})/2) : (E_{n+1} - E_n) dV
-// (for a linear system the newmark W is exactly the energy the scheme removes).
+//   backward, bdf2:  W = int S_v(Edot_{n+1}) : (E_{n+1} - E_n) dV
+//   trapezoidal:     W = int S_v((Edot_n + Edot_{n+1})/2) : (E_{n+1} - E_n) dV
+// (for a linear system the trapezoidal W is exactly the energy the scheme removes).
 // D is not convex in u for large dE; its Hessian is exact.
 #pragma once
 #include <Eigen/Dense>
+#include <memory>
 #include <vector>
 
 #include "fem/element.h"
 #include "fem/energy.h"
-#include "fem/inertia.h"
 #include "fem/material.h"
+#include "fem/time_integrator.h"
 #include "mesh/mesh.h"
 #include "mesh/partition.h"
 
@@ -67,10 +64,10 @@ class DampingTerm : public EnergyTerm {
  public:
   // shear_viscosity[region id], bulk_viscosity[region id] [Pa s] (empty bulk:
   // zero everywhere); pieces: cells of part `rank` with a positive viscosity.
-  // scheme: the inertia's time scheme (strain-rate discretisation above).
+  // integrator: the inertia's, whose rate rule discretises the strain rate (above).
   // quadrature_degree 0: 1 for P1 (E constant), 2 for P2.
   DampingTerm(const Mesh& mesh, const Partition& partition, int rank, std::vector<double> shear_viscosity,
-              std::vector<double> bulk_viscosity = {}, TimeScheme scheme = TimeScheme::implicit_euler,
+              std::vector<double> bulk_viscosity, std::shared_ptr<const TimeIntegrator> integrator,
               int quadrature_degree = 0);
 
   std::string name() const override { return "damping"; }
@@ -93,9 +90,9 @@ class DampingTerm : public EnergyTerm {
   std::vector<int> cells_;
   std::vector<double> eta_, zeta_;  // per piece [Pa s]
   ShapeTable table_;
-  TimeScheme scheme_;
-  double h_ = 0.0, kappa_ = 1.0, h_prev_ = 0.0;
-  bool trapezoidal_ = false;  // of the current step
+  std::shared_ptr<const TimeIntegrator> integrator_;
+  RateRule rule_;  // of the current step
+  double h_prev_ = 0.0;
   int steps_done_ = 0;
   // Per piece, per point: E_n, E*, and the history Edot_n [1/s], E_{n-1}.
   std::vector<std::vector<Mat3>> E_n_, E_star_, Edot_n_, E_nm1_;

@@ -86,11 +86,11 @@ std::vector<DirichletCondition> boundary_conditions(const Scene& scene, const Me
   return bcs;
 }
 
-// A dynamic scene's inertia starts at the scene's initial velocity.
+// A dynamic scene's time integrator starts at the scene's initial velocity.
 void start_inertia(Model& model) {
   if (!model.inertia) return;
   const Eigen::Vector3d v0 = model.scene.dynamics->initial_velocity;  // inertia only with dynamics
-  model.inertia->set_initial_velocity([v0](const Eigen::Vector3d&) { return v0; });
+  model.integrator->set_initial_velocity([v0](const Eigen::Vector3d&) { return v0; });
   model.inertia->initialize(*model.assembler, model.solver->solution(), 0.0);
 }
 
@@ -99,6 +99,7 @@ void start_inertia(Model& model) {
 Model::Model(const Scene& scene, Mesh& mesh, MPI_Comm comm) : scene(scene), mesh(mesh), comm(comm) {
   MPI_Comm_rank(comm, &rank);
   MPI_Comm_size(comm, &size);
+  if (scene.dynamics) integrator = std::make_shared<TimeIntegrator>(scene.dynamics->inertia);
 }
 
 std::string scene_key(const Scene& scene, const std::string& where, const std::string& key) {

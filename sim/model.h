@@ -20,6 +20,7 @@
 #include "fem/material.h"
 #include "fem/pull_spring.h"
 #include "fem/solver.h"
+#include "fem/time_integrator.h"
 #include "mesh/mesh.h"
 #include "mesh/partition.h"
 #include "sim/scene.h"
@@ -43,6 +44,9 @@ struct Model {
   Partition partition;
   std::unique_ptr<Assembler> assembler;
   std::unique_ptr<IncrementalSolver> solver;
+  // A dynamic scene's time integrator (null if quasi-static): the inertia term
+  // advances it, the damping discretises its strain rate with it.
+  std::shared_ptr<TimeIntegrator> integrator;
 
   // The terms the observers read; null or empty when the scene has none.
   std::shared_ptr<ElasticTerm> elastic;

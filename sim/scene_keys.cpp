@@ -9,7 +9,7 @@
 
 #include "core/strings.h"
 #include "fem/elastic.h"
-#include "fem/inertia.h"
+#include "fem/time_integrator.h"
 
 namespace morphfem {
 
@@ -198,7 +198,7 @@ void add_output_keys(Keys& t) {
 void add_dynamics_keys(Keys& t) {
   const Keys keys = {
       key("dynamics", K::mapping, "", "", "inertia and damping (absent: quasi-static)"),
-      choice("dynamics.scheme", "newmark", names_of(time_schemes()), "the time integrator (fem/inertia.h)"),
+      choice("dynamics.scheme", "newmark", names_of(time_schemes()), "the time integrator (fem/time_integrator.h)"),
       key("dynamics.lumped", K::number, "[-]", "0", "nonzero: lumped (diagonal) mass instead of consistent"),
       key("dynamics.adaptive", K::number, "[-]", "0",
           "nonzero: the truncation error estimate rejects steps and chooses dt"),

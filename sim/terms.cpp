@@ -108,7 +108,8 @@ void add_inertia(const Scene& scene, Model& m) {
   for (const auto& [region, params] : scene.materials)
     if (m.density[m.mesh.region(region, 3).id] <= 0)
       throw InputError(params.where("model"), "dynamics needs 'density' [kg/m^3] for material '" + region + "'");
-  m.inertia = std::make_shared<InertiaTerm>(m.mesh, m.partition, m.rank, m.density, scene.dynamics->inertia);
+  m.inertia = std::make_shared<InertiaTerm>(m.mesh, m.partition, m.rank, m.density, m.integrator,
+                                            scene.dynamics->inertia.lumped);
   m.assembler->add_term(m.inertia);
 }
 
@@ -118,7 +119,7 @@ void add_damping(const Scene& scene, Model& m) {
   if (!(dynamics.shear_viscosity > 0 || dynamics.bulk_viscosity > 0)) return;
   std::vector<double> eta(m.mesh.regions.size(), dynamics.shear_viscosity),
       zeta(m.mesh.regions.size(), dynamics.bulk_viscosity);
-  m.damping = std::make_shared<DampingTerm>(m.mesh, m.partition, m.rank, eta, zeta, dynamics.inertia.scheme);
+  m.damping = std::make_shared<DampingTerm>(m.mesh, m.partition, m.rank, eta, zeta, m.integrator);
   m.assembler->add_term(m.damping);
 }
 

@@ -76,6 +76,7 @@ struct Scene {
   Mesh mesh;
   Partition part;
   std::unique_ptr<Assembler> assembler;
+  std::shared_ptr<TimeIntegrator> integrator;
   std::shared_ptr<InertiaTerm> inertia;
   std::shared_ptr<DampingTerm> damping;
   int elastic_index = -1, gravity_index = -1;
@@ -89,7 +90,8 @@ struct Scene {
     materials[body] = neo_hookean(mu, nu);
     std::vector<double> density(mesh.regions.size(), 0.0);
     density[body] = kDensity;
-    inertia = std::make_shared<InertiaTerm>(mesh, part, 0, density, options);
+    integrator = std::make_shared<TimeIntegrator>(options);
+    inertia = std::make_shared<InertiaTerm>(mesh, part, 0, density, integrator, options.lumped);
     assembler->add_term(inertia);
     elastic_index = static_cast<int>(assembler->terms().size());
     assembler->add_term(std::make_shared<ElasticTerm>(mesh, part, 0, materials));
@@ -104,7 +106,7 @@ struct Scene {
     if (eta > 0) {
       std::vector<double> viscosity(mesh.regions.size(), 0.0);
       viscosity[body] = eta;
-      damping = std::make_shared<DampingTerm>(mesh, part, 0, viscosity, std::vector<double>{}, options.scheme);
+      damping = std::make_shared<DampingTerm>(mesh, part, 0, viscosity, std::vector<double>{}, integrator);
       assembler->add_term(damping);
     }
   }
