@@ -604,7 +604,18 @@ RunStats IncrementalSolver::run(const std::function<void(const StepReport&)>& on
   stats.failure.clear();
   for (const auto& term : assembler_.terms()) term->set_time(t_);
   std::vector<double> stops = opt_.output_times;
-  if (opt_.land_on_breakpoints) stops.insert(stops.end(), opt_.breakpoints.begin(), opt_.breakpoints.end());
+  if (opt_.land_on_breakpoints) {
+    // A breakpoint within kBreakpointMerge * dt_max of the one before is not a stop of
+    // its own (the end of a switch that takes a fraction of a millisecond).
+    std::vector<double> breaks = opt_.breakpoints;
+    std::sort(breaks.begin(), breaks.end());
+    double last = -1e300;
+    for (double b : breaks)
+      if (b - last > kBreakpointMerge * opt_.dt_max) {
+        stops.push_back(b);
+        last = b;
+      }
+  }
   stops.push_back(opt_.t_end);
   std::sort(stops.begin(), stops.end());
   double dt = dt_next_ > 0 ? std::min(dt_next_, opt_.dt_max) : std::min(opt_.dt_initial, opt_.dt_max);

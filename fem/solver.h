@@ -79,6 +79,8 @@ struct SolverOptions {
   std::vector<double> breakpoints;
   bool land_on_breakpoints = true;
 };
+// Breakpoints closer than this fraction of dt_max to the one before share its stop.
+constexpr double kBreakpointMerge = 0.02;
 
 struct StepReport {
   int step = 0;  // 1-based converged step count
