@@ -604,6 +604,18 @@ RunStats IncrementalSolver::run(const std::function<void(const StepReport&)>& on
   stats.failure.clear();
   for (const auto& term : assembler_.terms()) term->set_time(t_);
   std::vector<double> stops = opt_.output_times;
+  if (opt_.land_on_breakpoints) {
+    // A breakpoint within kBreakpointMerge * dt_max of the one before is not a stop of
+    // its own (the end of a switch that takes a fraction of a millisecond).
+    std::vector<double> breaks = opt_.breakpoints;
+    std::sort(breaks.begin(), breaks.end());
+    double last = -1e300;
+    for (double b : breaks)
+      if (b - last > kBreakpointMerge * opt_.dt_max) {
+        stops.push_back(b);
+        last = b;
+      }
+  }
   stops.push_back(opt_.t_end);
   std::sort(stops.begin(), stops.end());
   double dt = dt_next_ > 0 ? std::min(dt_next_, opt_.dt_max) : std::min(opt_.dt_initial, opt_.dt_max);
@@ -617,9 +629,16 @@ RunStats IncrementalSolver::run(const std::function<void(const StepReport&)>& on
         next_stop = s;
         break;
       }
-    double t_new = std::min(t_ + dt, next_stop);
-    // Never leave a sliver before an output time: stretch this step by up to 25 %.
-    if (next_stop - t_new < 0.25 * dt) t_new = next_stop;
+    double t_new = next_stop;
+    if (opt_.land_on_breakpoints) {
+      // n equal steps to the next stop, none longer than dt: no sliver before it.
+      const double n = std::max(1.0, std::ceil((next_stop - t_) / dt - 1e-9));
+      if (n > 1) t_new = t_ + (next_stop - t_) / n;
+    } else {
+      t_new = std::min(t_ + dt, next_stop);
+      // Never leave a sliver before an output time: stretch this step by up to 25 %.
+      if (next_stop - t_new < 0.25 * dt) t_new = next_stop;
+    }
     int its = 0, lits = 0;
     std::string why;
     if (solve_step(t_new, its, lits, why)) {

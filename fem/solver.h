@@ -71,7 +71,16 @@ struct SolverOptions {
   // quadratic convergence where it is positive definite.
   HessianProjection hessian_projection = HessianProjection::adaptive;  // README, "stalled on the Hessian's projection"
   std::vector<double> output_times;                                    // steps land exactly on these times
+  // Breakpoints of the loads [s] (a schedule's column boundaries and ramp ends, its foot
+  // switches): with land_on_breakpoints, steps land exactly on them too, and the steps
+  // up to each stop (breakpoint or output time) are equal and no longer than the current
+  // step, so a load switches at its own time whatever the step sequence. Without it,
+  // only output times are stops, and a step stretches by up to 25 % to reach one.
+  std::vector<double> breakpoints;
+  bool land_on_breakpoints = true;
 };
+// Breakpoints closer than this fraction of dt_max to the one before share its stop.
+constexpr double kBreakpointMerge = 0.02;
 
 struct StepReport {
   int step = 0;  // 1-based converged step count

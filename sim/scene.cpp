@@ -47,6 +47,7 @@ void read_solver(const SceneReader& r, const YAML::Node& s, Scene& scene) {
     r.optional(s, key, "rtol", solver.rtol);
     r.optional(s, key, "newton_velocity_tol", solver.newton_velocity_tol);
     r.optional(s, key, "extrapolate", solver.extrapolate);
+    r.optional(s, key, "land_on_breakpoints", solver.land_on_breakpoints);
     if (s["linear_solver"]) solver.linear_solver = r.choice(s["linear_solver"], "solver.linear_solver");
     if (s["hessian_projection"])
       solver.hessian_projection = r.choice(s["hessian_projection"], "solver.hessian_projection") == "always"

@@ -87,6 +87,12 @@ void ActuationReader::read_growth() {
     scene.growth.emplace_back(r.text(kv.second, key + ".growth." + name),
                               voxel_bladder_growth(schedule, channel, start, schedule.core_pressure_pa, voxel));
   }
+  // The growth is linear between the timeline's times: steps land on them.
+  const VoxelTimeline line = voxel_timeline(schedule, voxel);
+  std::vector<double> times;
+  for (const auto *phase : {&line.column_start, &line.actuation_end, &line.column_end})
+    for (double t : *phase) times.push_back(start + t);
+  r.land_on(times);
 }
 
 void ActuationReader::read_weightless() {
@@ -122,6 +128,7 @@ void ActuationReader::add_cavity(int channel, const std::string &surface, const 
   spec.surfaces = {surface};
   spec.axes = axes;
   spec.pressure = std::move(pressure);
+  r.land_on(spec.pressure);
   if (a[open_key]) {
     YAML::Node sleeve;
     sleeve["open_axis"] = a[open_key];
@@ -188,6 +195,7 @@ void ActuationReader::read_feet() {
     const TimeFunction mu = timing == "voxel"
                                 ? voxel_foot_friction(schedule, channel, start, mu_active, mu_inactive, voxel)
                                 : foot_friction(schedule, channel, start, mu_active, mu_inactive);
+    r.land_on(mu);
     const std::string surface = r.text(f[foot], key + ".feet." + foot);
     if (scene.ground)
       scene.friction->regions.push_back({surface, mu, mu});
@@ -199,6 +207,7 @@ void ActuationReader::read_feet() {
     if (timing != "voxel")
       r.fail(f, key + ".feet", "contact.lattice_floor.gap_foot_columns needs the voxel timing (growth actuation)");
     lattice.gap_foot_mu = voxel_gap_foot_friction(schedule, start, mu_active, mu_inactive, voxel);
+    r.land_on(*lattice.gap_foot_mu);
   }
 }
 

@@ -205,7 +205,17 @@ struct SceneReader {
       if (points.size() > 1 && !(points.back().first > points[points.size() - 2].first))
         fail(row, key, "table times must increase strictly");
     }
-    return TimeFunction(points);
+    TimeFunction f(points);
+    land_on(f);
+    return f;
+  }
+  // Records the times of a load's breakpoints, where steps land (SolverOptions::breakpoints).
+  void land_on(const TimeFunction& f) const {
+    if (scene)
+      for (const auto& point : f.points()) scene->solver.breakpoints.push_back(point.first);
+  }
+  void land_on(const std::vector<double>& times) const {
+    if (scene) scene->solver.breakpoints.insert(scene->solver.breakpoints.end(), times.begin(), times.end());
   }
 };
 
