@@ -250,31 +250,36 @@ void ActuationReader::read_cadence(std::size_t first_valve, std::size_t first_fo
   scene.settle = std::move(settle);
 }
 
-// actuation.channel_map: the tolerance_pa of every watched channel; the map must
-// drive it and play the schedule's pressures, as `hw play` would without
-// --allow-map-override. Without a map, every channel has the default tolerance.
+// actuation.channel_map: the tolerance_pa of every watched channel. The map must
+// accept the schedule and play its pressures on those channels, as `hw play` would
+// without --allow-map-override. Without a map, every channel has the default.
 void ActuationReader::read_channel_map(SettleSpec &settle) const {
   settle.tolerance_pa.fill(kDefaultSettleTolerancePa);
   if (!a["channel_map"]) return;
-  std::filesystem::path file = r.text(a["channel_map"], key + ".channel_map");
+  const std::string where = key + ".channel_map";
+  std::filesystem::path file = r.text(a["channel_map"], where);
   if (file.is_relative()) file = std::filesystem::path(r.file).parent_path() / file;
   settle.channel_map = file.string();
   const hw::ChannelMap map = hw::read_channel_map(settle.channel_map);  // its own errors name its file and line
-  const auto levels = map.effective_levels(schedule);
-  for (const auto &[index, channel] : settle.valves) {
-    const hw::ChannelSpec *driven = map.find(channel);
-    const std::string where = key + ".channel_map";
-    if (!driven)
-      r.fail(a["channel_map"], where,
-             "the map " + settle.channel_map + " does not drive " + channel_name(channel) +
-                 ", whose chamber the scene feeds through a valve: the bench would not wait for it");
-    if (levels[channel].inflate_pa != schedule.levels[channel].inflate_pa ||
-        levels[channel].deflate_pa != schedule.levels[channel].deflate_pa)
-      r.fail(a["channel_map"], where,
-             "the map " + settle.channel_map + " changes the pressures of " + channel_name(channel) + " (" +
-                 driven->where + "); the simulator plays the schedule's: put them in its pressures block");
-    settle.tolerance_pa[channel] = driven->tolerance_pa;
+  try {
+    map.check_schedule(schedule);
+  } catch (const InputError &e) {
+    r.fail(a["channel_map"], where, e.what());
   }
+  hw::PressurePlan plan = map.plan(schedule);
+  std::vector<hw::PressureChange> changed;
+  for (const hw::PressureChange &change : plan.changes)
+    for (const auto &[index, channel] : settle.valves)
+      if (change.channel == channel) changed.push_back(change);
+  if (!changed.empty()) {
+    plan.changes = changed;
+    r.fail(a["channel_map"], where,
+           "the map " + settle.channel_map +
+               " does not play the schedule's pressures on the valve-fed chambers, which the simulator does:\n" +
+               plan.describe_changes() + "put the map's pressures in the schedule's pressures block");
+  }
+  for (const auto &[index, channel] : settle.valves)
+    if (const hw::ChannelSpec *driven = map.find(channel)) settle.tolerance_pa[channel] = driven->tolerance_pa;
 }
 
 }  // namespace

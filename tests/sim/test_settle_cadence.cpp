@@ -348,12 +348,13 @@ TEST(SettleCadence, BadSettleInputNamesItsKey) {
   text = scene_text(kRigid);
   e = error_of(text.replace(text.find("map.yaml"), 8, "other.yaml"));
   EXPECT_NE(e.find("actuation.channel_map"), std::string::npos) << e;
-  EXPECT_NE(e.find("does not drive b1"), std::string::npos) << e;
+  EXPECT_NE(e.find("drives channel b1 but the map has no such channel"), std::string::npos) << e;
   text = map_text(files.dir.string());
   files.write("other.yaml", text.replace(text.find("tolerance_pa"), 0, "inflated_pa: 20000, "));
   text = scene_text(kRigid);
   e = error_of(text.replace(text.find("map.yaml"), 8, "other.yaml"));
-  EXPECT_NE(e.find("changes the pressures of b1"), std::string::npos) << e;
+  EXPECT_NE(e.find("does not play the schedule's pressures"), std::string::npos) << e;
+  EXPECT_NE(e.find("b1 columns 1-2: schedule 25.0 kPa, commanded 20.0 kPa (inflated_pa of"), std::string::npos) << e;
   // A fixed cadence: the map has nothing to do.
   std::string schedule = kSchedule;
   files.write("schedule.yaml", schedule.replace(schedule.find("mode: settle"), 12, "mode: fixed"));
