@@ -19,6 +19,7 @@
 #include "sim/scene.h"
 #include "sim/simulation.h"
 #include "tests/support/temp_dir.h"
+#include "tests/support/tube_scene.h"
 
 using namespace morphfem;
 namespace fs = std::filesystem;
@@ -48,17 +49,10 @@ output: {directory: out, every: 2, checkpoint_s: 0}
 
 // A valve-fed tube whose schedule plays in settle mode: the column starts the
 // schedule clock decided, which the loads follow, are part of the state.
-const char* kSettleTube = R"(
-name: settle_tube
-geometry: {type: thick_cylinder, inner_radius: 0.005, outer_radius: 0.01, height: 0.004, mesh_size: 0.004}
-materials:
-  body: {model: dragon_skin_30}
-boundary:
-  - {surface: sym_x, fix: [x]}
-  - {surface: sym_y, fix: [y]}
-  - {surface: zmin, fix: [z]}
-  - {surface: zmax, fix: [z]}
-actuation:
+const std::string kSettleTube = "name: settle_tube\n" +
+                                quarter_tube("inner_radius: 0.005, outer_radius: 0.01, height: 0.004, mesh_size: 0.004",
+                                             "{model: dragon_skin_30}") +
+                                R"(actuation:
   schedule: {morphfem_schedule: 1, cadence: {mode: settle, min_hold_s: 0.1},
              matrix: ["101", "000", "000", "000", "000", "000", "000", "000", "000", "000"],
              pressures: {feet: {inflate_pa: 0, deflate_pa: 0}}}

@@ -55,6 +55,7 @@
 #include "sim/scene.h"
 #include "sim/simulation.h"
 #include "tests/support/temp_dir.h"
+#include "tests/support/tube_scene.h"
 
 using namespace morphfem;
 
@@ -101,16 +102,9 @@ std::string map_text(const std::string& dir) {
 // The tube with b1 its inner wall; `material` rigid or soft.
 std::string scene_text(const std::string& material, const std::string& actuation_extra = "",
                        const std::string& valves = ",\n            valves: {fill_time_s: 0.2}") {
-  return "name: settle_tube\n"
-         "geometry: {type: thick_cylinder, inner_radius: 0.005, outer_radius: 0.01, height: 0.004, mesh_size: 0.004}\n"
-         "materials:\n  body: " +
-         material + R"(
-boundary:
-  - {surface: sym_x, fix: [x]}
-  - {surface: sym_y, fix: [y]}
-  - {surface: zmin, fix: [z]}
-  - {surface: zmax, fix: [z]}
-actuation: {schedule: schedule.yaml, channel_map: map.yaml, start: 0.2, bladders: {b1: inner}, volume_axes: [x, y])" +
+  return "name: settle_tube\n" +
+         quarter_tube("inner_radius: 0.005, outer_radius: 0.01, height: 0.004, mesh_size: 0.004", material) +
+         R"(actuation: {schedule: schedule.yaml, channel_map: map.yaml, start: 0.2, bladders: {b1: inner}, volume_axes: [x, y])" +
          valves + actuation_extra + R"(}
 solver: {end_time: 3.5, initial_step: 0.005, max_step: 0.005}
 )";
