@@ -2,7 +2,8 @@
 // model: the player against the emulator (hardware/) and the simulator (its
 // schedule clock, actuation/schedule_clock.h) start the columns at the same times
 // when they model the same plant; a compliant chamber fills later by what its
-// pressure-volume curve says; bad settle input is refused naming its key.
+// pressure-volume curve says; the model's valve supply and foot friction follow
+// its clock; bad settle input is refused naming its key.
 //
 // The plant. The scene feeds bladder b1, a quarter tube, through a valve with
 // fill time tau = V_ref / (C R T) = 0.2 s; the emulator runs the same valve law on
@@ -52,6 +53,7 @@
 #include "hardware/channel_map.h"
 #include "hardware/emulator.h"
 #include "hardware/player.h"
+#include "sim/model.h"
 #include "sim/scene.h"
 #include "sim/simulation.h"
 #include "tests/support/temp_dir.h"
@@ -311,6 +313,44 @@ TEST(SettleCadence, ACompliantChamberSettlesAsItsPressureVolumeCurveSays) {
                 << rigid << " s\n";
   }
   if (report()) std::cout << "soft tube: largest V / V_ref = " << grown / v_ref << "\n";
+}
+
+// The model binds the loads to its clock: the bladder's supply is the clock's
+// setpoint, and the feet's friction regions (after a region of contact.friction
+// itself) follow their rows of the columns the clock starts.
+TEST(SettleCadence, TheModelsLoadsFollowItsClock) {
+  const Files files("settle_model");
+  std::string schedule = kSchedule;
+  const std::string feet_rows = "\"0000\"\n  - \"0000\"\npressures";
+  schedule.replace(schedule.find(feet_rows), feet_rows.size(), "\"1010\"\n  - \"0101\"\npressures");
+  files.write("schedule.yaml", schedule);
+  const Scene scene = read_scene(files.write(
+      "scene.yaml", scene_text(kRigid, ", feet: {foot_a: zmin, foot_b: zmax, mu_active: 0.7, mu_inactive: 0.56}") +
+                        "contact:\n  ground: {point: [0, 0, -1], normal: [0, 0, 1], surfaces: [zmin, zmax, outer]}\n"
+                        "  friction: {regions: [{surface: outer, mu: 0.3}]}\n"));
+  Mesh mesh = build_scene_mesh(scene, PETSC_COMM_WORLD);
+  const std::unique_ptr<Model> model = build_model(scene, mesh, PETSC_COMM_WORLD);
+  ASSERT_TRUE(model->schedule_clock);
+  ScheduleClock& clock = *model->schedule_clock;
+  ASSERT_EQ(model->watched_valves.size(), 1u);
+  EXPECT_EQ(model->watched_valves[0].first, 0);  // b1
+  ASSERT_TRUE(clock.end_of_step(kStart, {}));    // column 1 at 0.2 s
+  ASSERT_TRUE(clock.end_of_step(0.7, {}));       // column 2 at 0.7 s
+  const GasCavitySpec& b1 = model->watched_valves[0].second->spec();
+  const auto& regions = model->friction->spec().regions;
+  ASSERT_EQ(regions.size(), 3u);
+  for (double t : {0.1, 0.3, 0.69, 0.75, 1.5}) {
+    EXPECT_EQ(b1.supply_gauge_pressure(t), clock.setpoint_pa(0, t)) << t;
+    EXPECT_EQ(regions[0].mu_static(t), 0.3) << t;
+    EXPECT_EQ(regions[1].mu_static(t), clock.foot_mu(kChannelFootA, t, 0.7, 0.56)) << t;
+    EXPECT_EQ(regions[2].mu_kinetic(t), clock.foot_mu(kChannelFootB, t, 0.7, 0.56)) << t;
+  }
+  EXPECT_EQ(b1.supply_gauge_pressure(0.3), kSwing);  // column 1 inflates b1
+  EXPECT_EQ(regions[1].mu_static(0.3), 0.7);         // foot A active in column 1
+  EXPECT_EQ(regions[2].mu_static(0.3), 0.56);
+  EXPECT_EQ(regions[1].mu_static(0.75), 0.56);  // and inactive in column 2, from its start at 0.7 s
+  EXPECT_EQ(regions[2].mu_static(0.75), 0.7);
+  EXPECT_EQ(regions[1].mu_static(0.1), 0.7) << "every foot is active at rest";
 }
 
 // Settle mode needs what it reads: valves (the pressures), chambers to watch, the
