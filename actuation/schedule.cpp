@@ -64,6 +64,22 @@ void parse_levels(const Reader& r, const YAML::Node& n, const std::string& key, 
   if (n["deflate_ramp_s"]) lv.deflate_ramp_s = r.number_in(n["deflate_ramp_s"], key + ".deflate_ramp_s", 0, 1e6);
 }
 
+Cadence parse_cadence(const Reader& r, const YAML::Node& n) {
+  if (!n.IsMap()) r.fail(n, "cadence", "expected a mapping {mode: fixed|settle, min_hold_s: S, timeout_s: S}");
+  r.allow_only(n, "cadence", {"mode", "min_hold_s", "timeout_s"});
+  Cadence c;
+  if (n["mode"]) {
+    const std::string mode = r.text(n["mode"], "cadence.mode");
+    if (mode == "settle")
+      c.mode = Cadence::Mode::settle;
+    else if (mode != "fixed")
+      r.fail(n["mode"], "cadence.mode", "expected fixed or settle, got '" + mode + "'");
+  }
+  if (n["min_hold_s"]) c.min_hold_s = r.number_in(n["min_hold_s"], "cadence.min_hold_s", 0, 1e6);
+  if (n["timeout_s"]) c.timeout_s = r.number_in(n["timeout_s"], "cadence.timeout_s", 1e-6, 1e6);
+  return c;
+}
+
 }  // namespace
 
 const std::string& channel_name(int channel) {
@@ -127,6 +143,12 @@ double ramp_towards(double value, double target, double rise_rate, double fall_r
   return value;
 }
 
+const char* cadence_mode_name(Cadence::Mode mode) { return mode == Cadence::Mode::settle ? "settle" : "fixed"; }
+
+bool channel_settled(double pressure_pa, double setpoint_pa, double target_pa, double tolerance_pa) {
+  return std::abs(setpoint_pa - target_pa) <= 0.5 && std::abs(pressure_pa - setpoint_pa) <= tolerance_pa;
+}
+
 std::array<ChannelLevels, kNumChannels> Schedule::default_levels(double core_pressure_pa) {
   std::array<ChannelLevels, kNumChannels> lv;
   for (int i = 0; i < kNumBladders; ++i) lv[i] = {25000.0, 0.0, 0.0, 0.0};
@@ -171,6 +193,8 @@ void Schedule::validate() const {
   if (repeats < 1) throw InputError(w + ": repeats", "must be at least 1");
   if (!(settle_s >= 0)) throw InputError(w + ": settle_s", "must be non-negative");
   if (orientation_deg < 0 || orientation_deg > 90) throw InputError(w + ": orientation_deg", "must be in 0..90");
+  if (!(cadence.min_hold_s >= 0)) throw InputError(w + ": cadence.min_hold_s", "must not be negative");
+  if (!(cadence.timeout_s > 0)) throw InputError(w + ": cadence.timeout_s", "must be positive");
   for (int c = 0; c < kNumChannels; ++c) {
     const auto& l = levels[c];
     if (!std::isfinite(l.inflate_pa) || !std::isfinite(l.deflate_pa))
@@ -235,7 +259,10 @@ std::string Schedule::to_yaml() const {
   o << "morphfem_schedule: 1\n";
   if (!name.empty()) o << "name: \"" << name << "\"\n";
   o << "orientation_deg: " << orientation_deg << "\ncore_pressure_pa: " << core_pressure_pa
-    << "\ncolumn_s: " << column_s << "\nrepeats: " << repeats << "\nsettle_s: " << settle_s << "\nmatrix:\n";
+    << "\ncolumn_s: " << column_s << "\nrepeats: " << repeats << "\nsettle_s: " << settle_s << "\n";
+  if (cadence.mode == Cadence::Mode::settle)
+    o << "cadence: {mode: settle, min_hold_s: " << cadence.min_hold_s << ", timeout_s: " << cadence.timeout_s << "}\n";
+  o << "matrix:\n";
   for (auto& row : matrix) {
     o << "  - \"";
     for (int v : row) o << v;
@@ -259,7 +286,7 @@ Schedule parse_schedule(const std::string& text, const std::string& source) {
   if (!root.IsMap()) throw InputError(source, "a schedule file is a YAML mapping (key: value)");
   r.allow_only(root, "",
                {"morphfem_schedule", "name", "orientation_deg", "core_pressure_pa", "column_s", "repeats", "settle_s",
-                "matrix", "genome", "pressures"});
+                "cadence", "matrix", "genome", "pressures"});
   if (!root["morphfem_schedule"])
     throw InputError(source, "missing required key 'morphfem_schedule' (format version, 1)");
   r.integer_in(root["morphfem_schedule"], "morphfem_schedule", 1, 1);
@@ -275,6 +302,7 @@ Schedule parse_schedule(const std::string& text, const std::string& source) {
   if (root["column_s"]) s.column_s = r.number_in(root["column_s"], "column_s", 1e-6, 1e6);
   if (root["repeats"]) s.repeats = r.integer_in(root["repeats"], "repeats", 1, 1000000);
   if (root["settle_s"]) s.settle_s = r.number_in(root["settle_s"], "settle_s", 0, 1e6);
+  if (root["cadence"]) s.cadence = parse_cadence(r, root["cadence"]);
 
   const bool has_matrix = bool(root["matrix"]), has_genome = bool(root["genome"]);
   if (has_matrix == has_genome)

@@ -22,6 +22,10 @@
 //     core_pressure_pa: 12000
 //     columns: 8
 //     rows: [[7, 7], [7, 6], ...]   # 10 pairs (f, phi), integers 0..8
+//   cadence:                    # optional; how one column follows the next (below)
+//     mode: settle              # fixed (default) or settle
+//     min_hold_s: 0.5           # settle: shortest column (default 0)
+//     timeout_s: 30             # settle: longest wait for the pressures (default 30)
 //   pressures:                  # optional levels; defaults below
 //     bladders: {inflate_pa: 25000, deflate_pa: 0, ramp_s: 0}     # all eight bladders
 //     b3:       {inflate_pa: 30000}                                 # one bladder (b1..b8)
@@ -43,6 +47,17 @@
 // study's settle phases), the core at its pressure. A setpoint moves towards the
 // level of the current column at its ramp rate starting from where it was, so it
 // is continuous and piecewise linear; at t = 0 it starts from the rest level.
+//
+// Cadence: with mode fixed every column lasts column_s (the time convention
+// above). With mode settle a column lasts until every driven channel has settled
+// (channel_settled: its setpoint has reached the column's level and its pressure
+// is within the channel's tolerance of it, tolerance_pa of the channel map,
+// default 2000 Pa), and at least min_hold_s; the rest phase before column 1
+// until every channel has settled and at least settle_s. A column that waits
+// longer than timeout_s is a fault. The player (`morphfem hw play`) reads the
+// regulators' pressures; the simulator the valve-fed cavities' (actuation/
+// schedule_clock.h), so one file gives one cadence on the bench and in the model;
+// column_s is then unused.
 // ---------------------------------------------------------------------------
 #pragma once
 #include <array>
@@ -100,6 +115,31 @@ struct ChannelLevels {
 // Moves `value` towards `target` for `dt` seconds at the given rates (Pa/s).
 double ramp_towards(double value, double target, double rise_rate, double fall_rate, double dt);
 
+// The cadence (schedule key `cadence`, see above).
+constexpr double kDefaultSettleTolerancePa = 2000;  // a channel map's tolerance_pa if it gives none
+
+struct Cadence {
+  enum class Mode { fixed, settle };
+  Mode mode = Mode::fixed;
+  double min_hold_s = 0;  // settle: shortest column [s]
+  double timeout_s = 30;  // settle: longest column [s]
+
+  // Settle mode: whether column k (-1: the rest phase, which lasts at least rest_s)
+  // may end after held_s [s], given whether every driven channel has settled.
+  bool may_end(int column, double held_s, double rest_s, bool settled) const {
+    return settled && held_s >= (column < 0 ? rest_s : min_hold_s);
+  }
+  // Settle mode: column k (not the rest phase) has waited longer than timeout_s.
+  bool timed_out(int column, double held_s) const { return column >= 0 && held_s > timeout_s; }
+};
+
+// "fixed" or "settle".
+const char* cadence_mode_name(Cadence::Mode mode);
+
+// A channel has settled when its setpoint is within 0.5 Pa of the column's level
+// (its ramp is over) and its pressure within tolerance_pa of the setpoint [Pa].
+bool channel_settled(double pressure_pa, double setpoint_pa, double target_pa, double tolerance_pa);
+
 struct ScheduleState {
   double t = 0;
   int column = -1;  // 0-based column over all repeats; -1 at rest (t < 0 or t >= duration)
@@ -120,6 +160,7 @@ class Schedule {
   double settle_s = 0;
   ScheduleMatrix matrix;         // 10 x T
   std::optional<Genome> genome;  // set when the file gave a genome
+  Cadence cadence;
   std::array<ChannelLevels, kNumChannels> levels = default_levels(0);
 
   static std::array<ChannelLevels, kNumChannels> default_levels(double core_pressure_pa);

@@ -17,8 +17,7 @@ TimeFunction from_samples(std::vector<std::pair<double, double>> points) {
 }
 }  // namespace
 
-TimeFunction channel_pressure(const Schedule& schedule, int channel, double start, double step_s) {
-  if (channel < 0 || channel >= kNumChannels) throw std::invalid_argument("channel out of range");
+std::array<ChannelLevels, kNumChannels> load_levels(const Schedule& schedule, double step_s) {
   std::array<ChannelLevels, kNumChannels> levels = schedule.levels;
   // Bladder and foot steps get a short ramp so the load is continuous:
   // rate = swing / step_s. The core is held at its pressure from the start of
@@ -28,6 +27,12 @@ TimeFunction channel_pressure(const Schedule& schedule, int channel, double star
     if (levels[c].inflate_ramp_s <= 0) levels[c].inflate_ramp_s = step_s;
     if (levels[c].deflate_ramp_s <= 0) levels[c].deflate_ramp_s = step_s;
   }
+  return levels;
+}
+
+TimeFunction channel_pressure(const Schedule& schedule, int channel, double start, double step_s) {
+  if (channel < 0 || channel >= kNumChannels) throw std::invalid_argument("channel out of range");
+  const std::array<ChannelLevels, kNumChannels> levels = load_levels(schedule, step_s);
   const ChannelLevels& lv = levels[channel];
   std::vector<double> times{-1.0};
   const int n = schedule.total_columns();

@@ -16,6 +16,10 @@ namespace morphfem {
 // the simulation's settle phase, where the solver's load steps ramp into it).
 TimeFunction channel_pressure(const Schedule& schedule, int channel, double start, double step_s = 1e-3);
 
+// The schedule's levels as the loads play them: a bladder or foot step (zero ramp
+// time) rises over `step_s` [s]; the core keeps its own ramp.
+std::array<ChannelLevels, kNumChannels> load_levels(const Schedule& schedule, double step_s);
+
 // Friction coefficient of a foot channel (kChannelFootA / kChannelFootB) over
 // simulation time: mu_active while the schedule says active, mu_inactive
 // otherwise, switching linearly over `switch_s` [s] at column boundaries.

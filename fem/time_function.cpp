@@ -11,7 +11,15 @@ TimeFunction::TimeFunction(std::vector<std::pair<double, double>> points) : poin
       throw std::invalid_argument("time function points must have strictly increasing times");
 }
 
+TimeFunction TimeFunction::of(std::function<double(double)> evaluate) {
+  TimeFunction f;
+  f.points_.clear();
+  f.evaluate_ = std::move(evaluate);
+  return f;
+}
+
 double TimeFunction::operator()(double t) const {
+  if (evaluate_) return evaluate_(t);
   if (t <= points_.front().first) return points_.front().second;
   if (t >= points_.back().first) return points_.back().second;
   for (size_t i = 1; i < points_.size(); ++i) {

@@ -59,8 +59,8 @@ struct ChannelSpec {
   int address = 0;  // unit letter as its ASCII code (alicat) or I2C address (booth)
   std::optional<double> inflated_pa, deflated_pa;
   double min_pa = 0, max_pa = 0;
-  double ramp_limit_pa_per_s = 0;  // 0 = no limit
-  double tolerance_pa = 2000;
+  double ramp_limit_pa_per_s = 0;                   // 0 = no limit
+  double tolerance_pa = kDefaultSettleTolerancePa;  // settle mode (actuation/schedule.h, Cadence)
   std::optional<double> min_fill_rate_pa_per_s;
   std::string where;  // "file:line:col: channels.b1" for messages
 };

@@ -45,7 +45,8 @@ const char* kCheckUsage =
 const char* kPlayUsage =
     "usage: morphfem hw play SCHEDULE --map MAP [options]\n"
     "  --port [DEVICE=]PATH           serial port of a device of the map (every device without DEVICE=)\n"
-    "  --mode fixed|settle|step       fixed column times (default); advance when settled; Enter = next, q = stop\n"
+    "  --mode fixed|settle|step       fixed column times; advance when settled; Enter = next, q = stop\n"
+    "                                 (default: the schedule's cadence.mode, else fixed)\n"
     "  --allow-map-override           play a schedule whose pressures the map changes (changes are listed)\n"
     "  --time-scale S                 schedule seconds per wall second (default 1; give the emulator the same)\n"
     "  --tick-ms N                    wall ms between exchanges (default 20 / S, at least 5)\n"
@@ -61,8 +62,8 @@ const char* kPlayUsage =
     "  --tracking-fault-pa P          backstop: |measured - commanded| ... (default 15000)\n"
     "  --tracking-fault-s S           ... for this long, schedule s (default 1)\n"
     "  --tracking-fault-samples N     ... over this many consecutive exchanges (default 5)\n"
-    "  --settle-timeout-s S           settle mode: longest column (default 30)\n"
-    "  --min-hold-s S                 settle mode: shortest column (default 0)\n"
+    "  --settle-timeout-s S           settle mode: longest column (default: cadence.timeout_s, else 30)\n"
+    "  --min-hold-s S                 settle mode: shortest column (default: cadence.min_hold_s, else 0)\n"
     "  --log FILE.csv                 CSV log (format: actuation/schedule.h)\n"
     "  --dry-run                      print the command stream; open no port\n"
     "  --no-display                   no live pressure line on stderr\n";
@@ -75,6 +76,8 @@ const char* kEmulateUsage =
     "  --seed N                  noise seed (default 1)\n"
     "  --noise-pa P              sensor noise, standard deviation (default 60)\n"
     "  --rupture-pa P            bladder rupture pressure (default 60000)\n"
+    "  --valve-fill-time-s T     the simulator's valve law on a rigid chamber, time constant T (default:\n"
+    "                            the regulator model; hardware/emulator.h)\n"
     "  --fault KIND@T[:ARG]      garble, drop, silence, delay, disconnect, stuck, rupture (hardware/emulator.h)\n"
     "  --duration-s S            stop after S wall seconds\n";
 
@@ -251,14 +254,18 @@ std::vector<Option> play_options(PlayerOptions& po, std::string& map_path) {
   };
 }
 
+// The options apply over the schedule's cadence: read the schedule, then them.
 int run_play(const std::vector<std::string>& args) {
-  PlayerOptions po;
-  po.display = isatty(2);
+  PlayerOptions checked;
   std::string map_path;
-  auto pos = parse_options("play", args, play_options(po, map_path));
+  auto pos = parse_options("play", args, play_options(checked, map_path));
   if (pos.size() != 1) throw InputError("hw play", "expected one schedule file (see morphfem hw play --help)");
   if (map_path.empty()) throw InputError("hw play", "--map MAP is required");
   Schedule s = read_schedule(pos[0]);
+  PlayerOptions po;
+  po.display = isatty(2);
+  take_cadence(s.cadence, po);
+  parse_options("play", args, play_options(po, map_path));
   ChannelMap m = read_channel_map(map_path);
   return play(s, m, po);
 }
@@ -303,6 +310,8 @@ int run_emulate(const std::vector<std::string>& args) {
        {"--seed", true, [&](const std::string& v) { ec.seed = static_cast<std::uint64_t>(count_arg("--seed", v)); }},
        {"--noise-pa", true, [&](const std::string& v) { ec.noise_pa = nonnegative_arg("--noise-pa", v); }},
        {"--rupture-pa", true, [&](const std::string& v) { ec.rupture_pa = positive_arg("--rupture-pa", v); }},
+       {"--valve-fill-time-s", true,
+        [&](const std::string& v) { ec.valve_fill_time_s = positive_arg("--valve-fill-time-s", v); }},
        {"--fault", true, [&](const std::string& v) { ec.faults.push_back(parse_fault(v)); }},
        {"--duration-s", true, [&](const std::string& v) { duration_s = positive_arg("--duration-s", v); }}});
   if (!pos.empty())

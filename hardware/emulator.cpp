@@ -229,7 +229,10 @@ void Emulator::step_physics(double dt) {
           u = std::abs(e) <= c.half_band_pa ? 0.0 : std::clamp(e / cfg_.valve_band_pa, -1.0, 1.0);
         }
         c.last_u = u;
-        dp = u > 0 ? u * (cfg_.supply_pa - c.p) / cfg_.tau_s : u * (c.p - cfg_.vacuum_pa) / cfg_.tau_s;
+        if (cfg_.valve_fill_time_s > 0 && !c.stuck)
+          dp = (c.sp - c.p) / cfg_.valve_fill_time_s;
+        else
+          dp = u > 0 ? u * (cfg_.supply_pa - c.p) / cfg_.tau_s : u * (c.p - cfg_.vacuum_pa) / cfg_.tau_s;
       } else if (c.mode == 0) {
         dp = -c.p / cfg_.vent_tau_s;
         c.last_u = 0;

@@ -11,6 +11,11 @@
 //   vent:     dp/dt = -p / vent_tau_s
 //   hold:     dp/dt = 0
 //   ruptured: the bladder leaks: dp/dt += -p / leak_tau_s, for ever.
+// With valve_fill_time_s > 0, regulate is instead the simulator's valve model
+// (actuation/gas_cavity.h) on a rigid chamber: the regulator's output holds the
+// setpoint and fills the chamber through a linear conductance C, so
+//             dp/dt = (setpoint - p) / valve_fill_time_s,
+// valve_fill_time_s = tau = V / (C R T) (a scene's actuation.valves.fill_time_s).
 // A channel ruptures when p exceeds rupture_pa. Measured pressure = p + N(0,
 // noise_pa), quantised (10 Pa for alicat, 10-bit sensor counts for booth).
 // Emulated time runs time_scale times faster than the wall clock.
@@ -59,6 +64,7 @@ struct EmulatorConfig {
   double supply_pa = 150000;
   double vacuum_pa = -95000;
   double tau_s = 0.12;
+  double valve_fill_time_s = 0;  // > 0: the valve model instead of the regulator's (above)
   double valve_band_pa = 4000;
   double vent_tau_s = 0.06;
   double leak_tau_s = 0.004;

@@ -648,9 +648,8 @@ bool Run::watch_pressures() {
       return false;
     }
     const ChannelSpec& c = regs_[i].spec;
-    const double tol = c.tolerance_pa > 0 ? c.tolerance_pa : 2000;
     const double target = std::clamp(s_.target_pa(c.channel, k_, levels_), c.min_pa, c.max_pa);
-    if (!(e <= tol) || std::abs(cmd_[i] - target) > 0.5) settled_ = false;
+    if (!channel_settled(meas_[i], cmd_[i], target, c.tolerance_pa)) settled_ = false;
   }
   return true;
 }
@@ -658,12 +657,12 @@ bool Run::watch_pressures() {
 // Settle mode: next column once settled and held; step mode: keys.
 void Run::step_modes() {
   if (opt_.mode == Mode::settle) {
-    const bool hold_done = tau_ >= (k_ < 0 ? s_.settle_s : opt_.min_hold_s);
-    if ((settled_ || opt_.dry_run) && hold_done) {
+    const Cadence cadence{Cadence::Mode::settle, opt_.min_hold_s, opt_.settle_timeout_s};
+    if (cadence.may_end(k_, tau_, s_.settle_s, settled_ || opt_.dry_run)) {
       log_->event(t_, k_ + 1, "event", "settled; column " + std::to_string(k_ + 2));
       enter_column(k_ + 1);
       pending_columns_.clear();
-    } else if (k_ >= 0 && tau_ > opt_.settle_timeout_s) {
+    } else if (cadence.timed_out(k_, tau_)) {
       fail(kExitFault, "pressures did not settle within " + std::to_string(opt_.settle_timeout_s) + " s in column " +
                            std::to_string(k_ + 1));
     }
@@ -811,6 +810,12 @@ int Run::execute() {
 }
 
 }  // namespace
+
+void take_cadence(const Cadence& cadence, PlayerOptions& options) {
+  options.mode = cadence.mode == Cadence::Mode::settle ? PlayerOptions::Mode::settle : PlayerOptions::Mode::fixed;
+  options.min_hold_s = cadence.min_hold_s;
+  options.settle_timeout_s = cadence.timeout_s;
+}
 
 int play(const Schedule& schedule, const ChannelMap& map, const PlayerOptions& options) {
   return Run(schedule, map, options).execute();

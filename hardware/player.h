@@ -36,6 +36,8 @@ constexpr int kExitSigint = 130;
 constexpr int kExitSigterm = 143;
 
 struct PlayerOptions {
+  // fixed and settle: the schedule's cadence (take_cadence; `hw play` overrides it
+  // with --mode, --min-hold-s, --settle-timeout-s); step: a key advances.
   enum class Mode { fixed, settle, step } mode = Mode::fixed;
   double time_scale = 1;                     // schedule seconds per wall second (tests: 10)
   double tick_s = 0;                         // wall seconds between control ticks (0: 0.02 / time_scale,
@@ -63,6 +65,10 @@ struct PlayerOptions {
   std::ostream* out = nullptr;               // dry-run command stream, summary (default std::cout)
   std::ostream* err = nullptr;               // messages, live display (default std::cerr)
 };
+
+// The schedule's cadence (schedule key `cadence`) as options: mode, min_hold_s,
+// settle_timeout_s.
+void take_cadence(const Cadence& cadence, PlayerOptions& options);
 
 // Plays the schedule; returns one of the exit codes above. Throws InputError
 // (nothing sent) if the schedule, the map or an option is refused.

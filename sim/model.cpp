@@ -6,6 +6,7 @@
 #include "core/strings.h"
 #include "mesh/geometry.h"
 #include "sim/broadcast.h"
+#include "sim/cadence.h"
 #include "sim/terms.h"
 
 namespace morphfem {
@@ -152,7 +153,9 @@ std::unique_ptr<Model> build_model(const Scene& scene, Mesh& mesh, MPI_Comm comm
   read_materials(*model);
   model->partition = partition_mesh(mesh, model->size);
   model->assembler = std::make_unique<Assembler>(mesh, model->partition, comm);
+  model->schedule_clock = make_schedule_clock(scene);
   for (const NamedTermBuilder& builder : term_builders()) builder.build(scene, *model);
+  watch_valves(*model);
   model->solver =
       std::make_unique<IncrementalSolver>(*model->assembler, boundary_conditions(scene, mesh), scene.solver);
   start_inertia(*model);

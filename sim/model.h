@@ -10,6 +10,8 @@
 #include <vector>
 
 #include "actuation/cavity.h"
+#include "actuation/gas_cavity.h"
+#include "actuation/schedule_clock.h"
 #include "contact/friction.h"
 #include "contact/ground.h"
 #include "contact/self_contact.h"
@@ -59,6 +61,10 @@ struct Model {
   std::shared_ptr<GroundContactTerm> ground;
   std::shared_ptr<FrictionTerm> friction;
   std::shared_ptr<SelfContactTerm> self_contact;
+  // Settle mode (Scene::settle, sim/cadence.h): the clock the schedule's loads
+  // follow, and the valve-fed chambers it watches (channel, term).
+  std::shared_ptr<ScheduleClock> schedule_clock;
+  std::vector<std::pair<int, std::shared_ptr<GasCavityTerm>>> watched_valves;
 };
 
 // Builds the mesh the scene asks for on rank 0 and broadcasts it; checks every

@@ -81,21 +81,33 @@ bool writes_output(const Scene& scene, const RunOptions& options) {
 
 // ---- Gait
 
-GaitMeter::GaitMeter(const Scene& scene, const Mesh& mesh)
+GaitMeter::GaitMeter(const Scene& scene, const Mesh& mesh, std::shared_ptr<const ScheduleClock> clock)
     : scene_(scene),
+      clock_(std::move(clock)),
       body_length_(scene.gait.body_length > 0 ? scene.gait.body_length
                                               : mesh.X.col(1).maxCoeff() - mesh.X.col(1).minCoeff()),
       mean_X_(mesh.X.colwise().mean()) {}
 
+double GaitMeter::start_time() const { return clock_ ? clock_->gait_start() : scene_.gait.start; }
+
+double GaitMeter::end_time() const { return clock_ ? clock_->gait_end() : scene_.gait.end; }
+
+// The cadence the speed belongs to (SimulationResult::cadence, column_starts, gait_s).
+void GaitMeter::note_cadence(SimulationResult& result) const {
+  result.cadence = scene_.gait.cadence;
+  result.column_starts = clock_ ? clock_->column_starts() : scene_.gait.column_starts;
+  result.gait_s = clock_ ? end_time() - start_time() : scene_.gait.nominal_s;
+}
+
 void GaitMeter::sample(double t, const RowMatrixXd& u, SimulationResult& result) {
-  const GaitSpec& gait = scene_.gait;
   const Eigen::Vector3d centroid = mean_X_ + Eigen::Vector3d(u.colwise().mean());
   result.trajectory.push_back({t, centroid.x(), centroid.y(), centroid.z()});
-  const double along = centroid.dot(gait.heading), eps = 1e-9 * std::max(1.0, scene_.solver.t_end);
-  if (std::abs(t - gait.start) <= eps) heading_at_start_ = along;
-  if (std::abs(t - gait.end) <= eps && std::isfinite(heading_at_start_)) {
+  note_cadence(result);
+  const double along = centroid.dot(scene_.gait.heading), eps = 1e-9 * std::max(1.0, scene_.solver.t_end);
+  if (std::abs(t - start_time()) <= eps) heading_at_start_ = along;
+  if (std::abs(t - end_time()) <= eps && std::isfinite(heading_at_start_)) {
     result.gait_displacement_m = along - heading_at_start_;
-    result.speed_bl_per_s = result.gait_displacement_m / body_length_ / gait.nominal_s;
+    result.speed_bl_per_s = result.gait_displacement_m / body_length_ / result.gait_s;
     result.gait_complete = true;
   }
 }
@@ -118,6 +130,33 @@ void GaitMeter::load(const StateRecord& saved, const std::string& where, Simulat
   const auto& path = saved.array("run.trajectory", where);
   for (size_t i = 0; i + 3 < path.size(); i += 4)
     result.trajectory.push_back({path[i], path[i + 1], path[i + 2], path[i + 3]});
+  note_cadence(result);  // the clock is loaded first (Stepper::restore)
+}
+
+// The cadence: its mode and parameters, the columns' start times [s] (settle: as
+// realised; with the gait's end as the last entry once it ended) and their mean length.
+Json GaitMeter::cadence_summary(const SimulationResult& result) const {
+  const Cadence& cadence = scene_.gait.cadence;
+  const std::vector<double>& starts = result.column_starts;
+  // The columns that ended: in settle mode each start but the last ends one.
+  const double ended = clock_ ? static_cast<double>(starts.size()) - 1 : static_cast<double>(starts.size());
+  const double last = clock_ ? (starts.empty() ? 0.0 : starts.back()) : end_time();
+  Json json;
+  json.add("mode", cadence_mode_name(cadence.mode));
+  if (clock_) {
+    Json tolerance;
+    for (const auto& [index, channel] : scene_.settle->valves)
+      tolerance.add(channel_name(channel), clock_->tolerance_pa(channel));
+    json.add("min_hold_s", cadence.min_hold_s)
+        .add("timeout_s", cadence.timeout_s)
+        .add("tolerance_pa", tolerance)
+        .add("channel_map", scene_.settle->channel_map)
+        .add("timed_out_column", clock_->timed_out_column() + 1);  // 1-based, 0: none
+  }
+  json.add("column_starts_s", starts)
+      .add("gait_end_s", end_time())
+      .add("mean_column_s", ended > 0 ? (last - starts.front()) / ended : std::numeric_limits<double>::quiet_NaN());
+  return json;
 }
 
 void GaitMeter::summarize(const SimulationResult& result, Json& summary) const {
@@ -125,9 +164,10 @@ void GaitMeter::summarize(const SimulationResult& result, Json& summary) const {
   summary.add("gait_complete", result.gait_complete)
       .add("displacement_m", result.gait_displacement_m)
       .add("speed_bl_per_s", result.speed_bl_per_s)
-      .add("gait_time_s", gait.nominal_s)
-      .add("simulated_gait_s", gait.end - gait.start)
-      .add("gait_start_s", gait.start)
+      .add("gait_time_s", result.gait_s)
+      .add("simulated_gait_s", end_time() - start_time())
+      .add("gait_start_s", start_time())
+      .add("cadence", cadence_summary(result))
       .add("body_length_m", body_length_)
       .add("heading", std::vector<double>{gait.heading.x(), gait.heading.y(), gait.heading.z()});
 }
@@ -154,7 +194,7 @@ Observers::Observers(Model& model, const RunOptions& options, SimulationResult& 
       pull_columns_(pull_columns(model)),
       energy_columns_(energy_columns(model)),
       pull_force_(model.pulls.size(), 0.0),
-      gait_(model.scene, model.mesh),
+      gait_(model.scene, model.mesh, model.schedule_clock),
       progress_(model.scene.name, model.scene.solver.t_end, options.progress) {
   if (!write_ || model.rank != 0) return;
   if (options.resume) {

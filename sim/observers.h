@@ -22,10 +22,13 @@ bool writes_output(const Scene& scene, const RunOptions& options);
 
 // The gait of a scene that plays a schedule: the mean node position (the voxel
 // study's "mean vertex") every step, and its displacement along the heading from
-// gait.start to gait.end in body lengths per nominal gait time.
+// the gait's start to its end in body lengths per gait time: with a fixed cadence
+// gait.start, gait.end and the nominal gait time; in settle mode the first
+// column's start and the gait's end as the schedule clock decided them, and the
+// time between them.
 class GaitMeter {
  public:
-  GaitMeter(const Scene& scene, const Mesh& mesh);
+  GaitMeter(const Scene& scene, const Mesh& mesh, std::shared_ptr<const ScheduleClock> clock);
   void sample(double t, const RowMatrixXd& u, SimulationResult& result);
   // The measurement so far, in a checkpoint (run.*).
   void save(const SimulationResult& result, StateRecord& state) const;
@@ -35,7 +38,13 @@ class GaitMeter {
   static void write_trajectory(const SimulationResult& result, const std::string& dir);
 
  private:
+  double start_time() const;  // [s], NaN while unknown
+  double end_time() const;
+  void note_cadence(SimulationResult& result) const;
+  Json cadence_summary(const SimulationResult& result) const;
+
   const Scene& scene_;
+  std::shared_ptr<const ScheduleClock> clock_;  // settle mode, else null
   double body_length_;
   Eigen::Vector3d mean_X_;
   double heading_at_start_ = std::numeric_limits<double>::quiet_NaN();

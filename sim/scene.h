@@ -96,6 +96,10 @@
 //     # weightless_inflated: the voxel study's inflated bladder voxels get no gravity
 //     # timing: schedule (columns of column_s) or voxel (the lattice's column
 //     # lengths: actuation phase + settle with every foot active); growth implies voxel.
+//     # A schedule whose cadence.mode is settle (actuation/schedule.h) starts each column
+//     # once the valve-fed chambers' pressures have settled, as `hw play --mode settle`
+//     # (actuation/schedule_clock.h); channel_map: MAP gives the tolerances (tolerance_pa).
+//     # It needs valves and the schedule timing.
 //   environment:                                # the study's ground: gravity rotated
 //     {slope_deg: 15, heading_deg: 90,          # heading default: the schedule's orientation
 //      gravity: 9.80665, body_length: 0.22}     # m/s^2; m (default: the mesh's y extent)
@@ -118,6 +122,7 @@
 
 #include "actuation/cavity.h"
 #include "actuation/gas_cavity.h"
+#include "actuation/schedule.h"
 #include "contact/friction.h"
 #include "contact/ground.h"
 #include "contact/lattice_floor.h"
@@ -173,10 +178,30 @@ struct DynamicsSpec {
 // The gait measurement of a scene that plays a schedule (see `environment`).
 struct GaitSpec {
   bool enabled = false;
-  double start = 0.0, end = 0.0;  // simulation times of the gait's first column and its end [s]
-  double nominal_s = 0.0;         // the schedule's nominal duration (speeds divide by it, as the study) [s]
+  // Simulation times of the gait's first column and its end [s]; in settle mode the
+  // earliest start of the first column, and the end is decided by the run (NaN).
+  double start = 0.0, end = 0.0;
+  double nominal_s = 0.0;  // the schedule's nominal duration (speeds divide by it in fixed mode, as the study) [s]
+  Cadence cadence;         // the schedule's cadence (actuation/schedule.h), reported with the speed
+  std::vector<double> column_starts;  // fixed mode: the columns' start times [s] (settle: the run's clock)
   Eigen::Vector3d heading = Eigen::Vector3d::UnitX();
   double body_length = 0.0;  // [m]; <= 0: the mesh's extent along y
+};
+
+// A schedule played in settle mode (its cadence.mode): what the run's schedule
+// clock needs (actuation/schedule_clock.h) and the loads that follow it.
+struct SettleSpec {
+  Schedule schedule;
+  double start = 0.0;                               // the earliest start of column 1 [s] (actuation.start)
+  std::array<double, kNumChannels> tolerance_pa{};  // per channel [Pa]: actuation.channel_map's tolerance_pa
+  std::string channel_map;                          // the map's file ("": none, the default tolerance)
+  // Gas cavities (index into Scene::gas_cavities) fed by a channel through a valve:
+  // the clock watches their pressures; their supply follows the clock (but the core's,
+  // whose setpoint does not depend on the column).
+  std::vector<std::pair<std::size_t, int>> valves;
+  // Friction regions (index into FrictionSpec::regions) of the feet, and their channel.
+  std::vector<std::pair<std::size_t, int>> feet;
+  double mu_active = 2.0, mu_inactive = 1e-4;  // the feet's coefficients (actuation.feet)
 };
 
 struct Scene {
@@ -216,6 +241,7 @@ struct Scene {
   // gravity while its thickness stretch g_z > 1 (inflating, inflated or deflating).
   bool weightless_inflated = false;
   GaitSpec gait;
+  std::optional<SettleSpec> settle;  // a schedule in settle mode (actuation.schedule's cadence)
   SolverOptions solver;
   std::string formulation = "displacement";  // elastic element formulation (fem/elastic.h)
   int quadrature_degree = 0;

@@ -3,9 +3,11 @@
 // environment (slope, heading, gravity, body length).
 #include <cmath>
 #include <filesystem>
+#include <limits>
 
 #include "actuation/schedule_loads.h"
 #include "actuation/voxel_growth.h"
+#include "hardware/channel_map.h"
 #include "sim/scene_reader.h"
 
 namespace morphfem {
@@ -45,6 +47,7 @@ struct ActuationReader {
   std::array<bool, 3> axes{true, true, true};
   bool valves = false;
   GasCavitySpec valve;
+  double mu_active = 2.0, mu_inactive = 1e-4;  // the feet's (actuation.feet)
 
   void read_timing();
   void read_growth();
@@ -54,6 +57,8 @@ struct ActuationReader {
   void read_bladders();
   void read_core();
   void read_feet();
+  void read_cadence(std::size_t first_valve, std::size_t first_foot);
+  void read_channel_map(SettleSpec &settle) const;
 };
 
 // The start, the timing and the gait they give.
@@ -71,6 +76,12 @@ void ActuationReader::read_timing() {
   scene.gait.start = start;
   scene.gait.end = start + gait_s;
   scene.gait.nominal_s = schedule.duration();
+  scene.gait.cadence = schedule.cadence;
+  if (timing == "voxel")
+    for (double t : voxel_timeline(schedule, voxel).column_start) scene.gait.column_starts.push_back(start + t);
+  else
+    for (int k = 0; k < schedule.total_columns(); ++k)
+      scene.gait.column_starts.push_back(start + k * schedule.column_s);
   // A run shorter than the gait plays only part of the schedule; its summary
   // then says gait_complete: false and reports no speed.
 }
@@ -185,8 +196,8 @@ void ActuationReader::read_feet() {
   r.allow(f, key + ".feet");
   if (!scene.ground && !scene.lattice_floor)
     r.fail(f, key + ".feet", "foot friction needs contact.ground (or contact.lattice_floor)");
-  const double mu_active = f["mu_active"] ? r.calibrated_number(f["mu_active"], key + ".feet.mu_active") : 2.0;
-  const double mu_inactive = f["mu_inactive"] ? r.calibrated_number(f["mu_inactive"], key + ".feet.mu_inactive") : 1e-4;
+  if (f["mu_active"]) mu_active = r.calibrated_number(f["mu_active"], key + ".feet.mu_active");
+  if (f["mu_inactive"]) mu_inactive = r.calibrated_number(f["mu_inactive"], key + ".feet.mu_inactive");
   // Ground contact: friction regions; the lattice floor only: its foot voxels.
   if (scene.ground && !scene.friction) scene.friction.emplace();
   for (const auto &[foot, channel] :
@@ -211,6 +222,75 @@ void ActuationReader::read_feet() {
   }
 }
 
+// A schedule in settle mode (its cadence.mode): the valve-fed chambers read from
+// first_valve on in scene.gas_cavities, the feet's friction regions from
+// first_foot on, and the tolerances of actuation.channel_map.
+void ActuationReader::read_cadence(std::size_t first_valve, std::size_t first_foot) {
+  if (schedule.cadence.mode != Cadence::Mode::settle) {
+    if (a["channel_map"])
+      r.fail(a["channel_map"], key + ".channel_map",
+             "the map's tolerances serve settle mode, but schedule " + schedule.source + " has cadence.mode fixed");
+    return;
+  }
+  const std::string why = "schedule " + schedule.source + " plays in settle mode (cadence.mode: settle)";
+  if (timing != "schedule")
+    r.fail(a["timing"] ? a["timing"] : a["growth"], key + ".timing",
+           why + ", which needs the schedule timing and valve-fed chambers, not the voxel timing");
+  if (!valves)
+    r.fail(a, key + ".valves",
+           why + ": its columns follow the chambers' pressures, which need the valve model (give actuation.valves)");
+  if (first_valve == scene.gas_cavities.size())
+    r.fail(a, key, why + ": no chamber (actuation.bladders or actuation.core) is fed through a valve to watch");
+  if (a["feet"] && !scene.ground)
+    r.fail(a["feet"], key + ".feet", why + ": foot friction follows the columns on contact.ground only");
+  SettleSpec settle;
+  settle.schedule = schedule;
+  settle.start = start;
+  settle.mu_active = mu_active;
+  settle.mu_inactive = mu_inactive;
+  for (std::size_t i = first_valve; i < scene.gas_cavities.size(); ++i)
+    settle.valves.emplace_back(i, channel_index(scene.gas_cavities[i].wall.name));
+  std::size_t region = first_foot;
+  for (const auto &[foot, channel] : {std::pair<const char *, int>{"foot_a", kChannelFootA}, {"foot_b", kChannelFootB}})
+    if (a["feet"] && a["feet"][foot]) settle.feet.emplace_back(region++, channel);
+  read_channel_map(settle);
+  scene.gait.end = std::numeric_limits<double>::quiet_NaN();  // decided by the run
+  scene.gait.column_starts.clear();
+  scene.settle = std::move(settle);
+}
+
+// actuation.channel_map: the tolerance_pa of every watched channel. The map must
+// accept the schedule and play its pressures on those channels, as `hw play` would
+// without --allow-map-override. Without a map, every channel has the default.
+void ActuationReader::read_channel_map(SettleSpec &settle) const {
+  settle.tolerance_pa.fill(kDefaultSettleTolerancePa);
+  if (!a["channel_map"]) return;
+  const std::string where = key + ".channel_map";
+  std::filesystem::path file = r.text(a["channel_map"], where);
+  if (file.is_relative()) file = std::filesystem::path(r.file).parent_path() / file;
+  settle.channel_map = file.string();
+  const hw::ChannelMap map = hw::read_channel_map(settle.channel_map);  // its own errors name its file and line
+  try {
+    map.check_schedule(schedule);
+  } catch (const InputError &e) {
+    r.fail(a["channel_map"], where, e.what());
+  }
+  hw::PressurePlan plan = map.plan(schedule);
+  std::vector<hw::PressureChange> changed;
+  for (const hw::PressureChange &change : plan.changes)
+    for (const auto &[index, channel] : settle.valves)
+      if (change.channel == channel) changed.push_back(change);
+  if (!changed.empty()) {
+    plan.changes = changed;
+    r.fail(a["channel_map"], where,
+           "the map " + settle.channel_map +
+               " does not play the schedule's pressures on the valve-fed chambers, which the simulator does:\n" +
+               plan.describe_changes() + "put the map's pressures in the schedule's pressures block");
+  }
+  for (const auto &[index, channel] : settle.valves)
+    if (const hw::ChannelSpec *driven = map.find(channel)) settle.tolerance_pa[channel] = driven->tolerance_pa;
+}
+
 }  // namespace
 
 std::optional<Schedule> read_actuation(const SceneReader &r, const YAML::Node &a, Scene &scene) {
@@ -223,9 +303,12 @@ std::optional<Schedule> read_actuation(const SceneReader &r, const YAML::Node &a
   actuation.read_weightless();
   if (a["volume_axes"]) actuation.axes = r.axes(a["volume_axes"], "actuation.volume_axes");
   actuation.read_valves();
+  const std::size_t first_valve = scene.gas_cavities.size();
   actuation.read_bladders();
   actuation.read_core();
+  const std::size_t first_foot = scene.friction ? scene.friction->regions.size() : 0;
   actuation.read_feet();
+  actuation.read_cadence(first_valve, first_foot);
   return schedule;
 }
 

@@ -272,8 +272,13 @@ void add_actuation_keys(Keys& t) {
       key("actuation", K::mapping, "", "",
           "a schedule played through bladder cavities or voxel growth, with foot friction"),
       key("actuation.schedule", K::schedule, "", "required",
-          "the schedule (actuation/schedule.h), shared with `morphfem hw play`"),
-      key("actuation.start", K::number, "[s]", "0", "simulation time of the gait's time 0", kNonNegative),
+          "the schedule (actuation/schedule.h), shared with `morphfem hw play`; with cadence.mode settle a column "
+          "starts once the valve-fed chambers' pressures have settled (actuation/schedule_clock.h)"),
+      key("actuation.start", K::number, "[s]", "0",
+          "simulation time of the gait's time 0 (settle mode: the earliest start of column 1)", kNonNegative),
+      key("actuation.channel_map", K::file, "", "",
+          "settle mode: the channel map (hardware/channel_map.h) whose tolerance_pa each chamber settles to "
+          "(absent: 2000 Pa); it must drive every valve-fed chamber at the schedule's pressures"),
       choice("actuation.timing", "schedule (voxel with growth)", {"schedule", "voxel"},
              "the schedule's columns, or the voxel lattice's timing (actuation phase + settle)"),
       key("actuation.bladders", K::mapping, "", "", "channel -> cavity wall surface"),

@@ -36,6 +36,13 @@ struct SimulationResult {
   std::vector<std::array<double, 4>> trajectory;
   bool gait_complete = false;
   double gait_displacement_m = 0, speed_bl_per_s = 0;
+  // The cadence the speed belongs to: the schedule's (cadence.mode, min_hold_s), the
+  // simulation times at which the columns began (settle mode: as the run decided
+  // them so far; a (K+1)-th entry is the gait's end) and the gait time the speed
+  // divides by (fixed: the nominal one, settle: the realised one) [s].
+  Cadence cadence;
+  std::vector<double> column_starts;
+  double gait_s = 0;
   bool stopped = false;    // stopped by RunOptions::stop_after_steps (output left in OUTPUT.partial)
   double resumed_at = -1;  // time of the checkpoint this run resumed from [s] (-1: not resumed)
 };

@@ -8,6 +8,7 @@
 
 #include "core/errors.h"
 #include "sim/broadcast.h"
+#include "sim/cadence.h"
 
 namespace morphfem {
 
@@ -127,6 +128,7 @@ Stepper::Stepper(Model& model, Observers& observers, const RunOptions& options, 
 
 void Stepper::restore(const ResumePoint& checkpoint) {
   last_written_ = static_cast<int>(checkpoint.state.integer("run.last_written", checkpoint.where));
+  if (model_.schedule_clock) model_.schedule_clock->load(checkpoint.state, "run.cadence.", checkpoint.where);
   observers_.load(checkpoint.state, checkpoint.where);
 }
 
@@ -142,6 +144,7 @@ void Stepper::run() {
 }
 
 void Stepper::on_step(const StepReport& r) {
+  advance_schedule_clock(model_, r.t);  // first: a column that starts at r.t is recorded with its step
   const double t_end = model_.scene.solver.t_end;
   const bool last = r.t >= t_end - 1e-12 * t_end;
   observers_.record(r.t, last, r.step);
@@ -180,6 +183,7 @@ void Stepper::save_checkpoint(const std::string& dir) {
   state.integers["run.last_written"] = last_written_;
   state.texts["run.scene"] = options_.scene_text;
   state.set_number("run.wall_s", clock_.total());
+  if (model_.schedule_clock) model_.schedule_clock->save(state, "run.cadence.");
   observers_.save(state);
   write_state_file(dir + "/checkpoint.h5", state);
 }

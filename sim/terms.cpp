@@ -11,6 +11,7 @@
 #include "core/errors.h"
 #include "fem/loads.h"
 #include "mesh/robot.h"
+#include "sim/cadence.h"
 
 namespace morphfem {
 
@@ -78,8 +79,9 @@ void add_cavities(const Scene& scene, Model& m) {
 
 // Cavities whose pressure follows from their volume: gas-filled, then volume-controlled.
 void add_volume_cavities(const Scene& scene, Model& m) {
-  for (const auto& spec : scene.gas_cavities)
-    m.volume_driven.push_back(std::make_shared<GasCavityTerm>(m.mesh, m.partition, m.rank, spec));
+  for (std::size_t i = 0; i < scene.gas_cavities.size(); ++i)
+    m.volume_driven.push_back(
+        std::make_shared<GasCavityTerm>(m.mesh, m.partition, m.rank, clocked_gas_cavity(scene, m, i)));
   for (const auto& spec : scene.volume_cavities)
     m.volume_driven.push_back(std::make_shared<VolumeControlledCavityTerm>(m.mesh, m.partition, m.rank, spec));
   for (const auto& c : m.volume_driven) m.assembler->add_term(c);
@@ -136,7 +138,7 @@ void add_ground(const Scene& scene, Model& m) {
 // Friction on the ground contact (none without it).
 void add_friction(const Scene& scene, Model& m) {
   if (!scene.ground || !scene.friction) return;
-  m.friction = std::make_shared<FrictionTerm>(m.mesh, m.partition, m.rank, m.ground, *scene.friction);
+  m.friction = std::make_shared<FrictionTerm>(m.mesh, m.partition, m.rank, m.ground, clocked_friction(scene, m));
   m.assembler->add_term(m.friction);
 }
 

@@ -166,6 +166,36 @@ TEST(Player, CliRefusesABadTrackingFaultSampleCount) {
   }
 }
 
+// `hw play` takes the mode and the hold from the schedule's cadence block; its
+// options override them (a dry run advances a settle column once its hold is over).
+TEST(Player, CliTakesTheCadenceFromTheSchedule) {
+  const std::string dir = temp_dir("cadence_cli");
+  Schedule s = read_schedule(kExamples + "rolling.yaml");
+  s.repeats = 1;
+  s.cadence = {Cadence::Mode::settle, 0.3, 30};
+  std::ofstream(dir + "/settle.yaml") << s.to_yaml();
+  auto column_starts = [&](const std::vector<std::string>& options) {
+    std::vector<std::string> args{
+        "play",  dir + "/settle.yaml", "--map", kExamples + "channel_map.yaml", "--allow-map-override", "--dry-run",
+        "--log", dir + "/log.csv"};
+    args.insert(args.end(), options.begin(), options.end());
+    const CliResult r = run_cli(args);
+    EXPECT_EQ(r.code, kExitOk) << r.err;
+    std::vector<double> starts;
+    for (const auto& e : read_pressure_log(dir + "/log.csv").events)
+      if (e.message.rfind("settled; column", 0) == 0) starts.push_back(e.t);
+    return starts;
+  };
+  std::vector<double> settle = column_starts({});
+  ASSERT_EQ(settle.size(), 9u) << "the rest phase and 8 columns";
+  for (std::size_t k = 1; k < settle.size(); ++k) EXPECT_NEAR(settle[k] - settle[k - 1], 0.3, 0.021) << k;
+  std::vector<double> longer = column_starts({"--min-hold-s", "0.5"});
+  ASSERT_EQ(longer.size(), 9u);
+  EXPECT_NEAR(longer[8] - longer[1], 7 * 0.5, 7 * 0.021);
+  EXPECT_TRUE(column_starts({"--mode", "fixed"}).empty()) << "fixed columns are not settled";
+  std::filesystem::remove_all(dir);
+}
+
 TEST(Player, DryRunPrintsTheCommandStream) {
   ChannelMap m = read_channel_map(kExamples + "channel_map.yaml");
   PlayerOptions opt;

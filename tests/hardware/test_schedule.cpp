@@ -228,6 +228,57 @@ TEST(ScheduleFile, ErrorsNameFileLineAndKey) {
   }
 }
 
+// The cadence block: settle mode with its hold and timeout, kept by to_yaml; an
+// unknown mode, a negative hold, a timeout of 0 or an unknown key name the file,
+// line and key.
+TEST(ScheduleFile, CadenceKeys) {
+  std::string matrix = "matrix:\n";
+  for (int i = 0; i < kNumRows; ++i) matrix += "  - \"01\"\n";
+  const std::string head = "morphfem_schedule: 1\n";
+  Schedule fixed = parse_schedule(head + matrix, "fixed.yaml");
+  EXPECT_EQ(fixed.cadence.mode, Cadence::Mode::fixed);
+  Schedule s = parse_schedule(head + "cadence: {mode: settle, min_hold_s: 0.4, timeout_s: 12}\n" + matrix, "s.yaml");
+  EXPECT_EQ(s.cadence.mode, Cadence::Mode::settle);
+  EXPECT_EQ(s.cadence.min_hold_s, 0.4);
+  EXPECT_EQ(s.cadence.timeout_s, 12);
+  Schedule back = parse_schedule(s.to_yaml(), "roundtrip.yaml");
+  EXPECT_EQ(back.cadence.mode, Cadence::Mode::settle);
+  EXPECT_EQ(back.cadence.min_hold_s, 0.4);
+  EXPECT_EQ(back.cadence.timeout_s, 12);
+  std::string e = expect_error(head + "cadence: {mode: eager}\n" + matrix);
+  EXPECT_NE(e.find("bad.yaml:2:17: cadence.mode"), std::string::npos) << e;
+  EXPECT_NE(e.find("expected fixed or settle, got 'eager'"), std::string::npos) << e;
+  e = expect_error(head + "cadence: {mode: settle, min_hold_s: -0.5}\n" + matrix);
+  EXPECT_NE(e.find("bad.yaml:2:37: cadence.min_hold_s"), std::string::npos) << e;
+  EXPECT_NE(e.find("outside the allowed range"), std::string::npos) << e;
+  e = expect_error(head + "cadence: {mode: settle, timeout_s: 0}\n" + matrix);
+  EXPECT_NE(e.find("cadence.timeout_s"), std::string::npos) << e;
+  e = expect_error(head + "cadence: {mode: settle, hold_s: 1}\n" + matrix);
+  EXPECT_NE(e.find("unknown key 'hold_s'"), std::string::npos) << e;
+  e = expect_error(head + "cadence: settle\n" + matrix);
+  EXPECT_NE(e.find("bad.yaml:2:10: cadence"), std::string::npos) << e;
+  // Built in code: validate() names the key.
+  Schedule code = Schedule::from_matrix(s.matrix);
+  code.cadence.min_hold_s = -1;
+  EXPECT_THROW(code.validate(), InputError);
+}
+
+// A channel has settled when its ramp is over and its pressure is within the
+// tolerance; a column may end once every channel has and the hold has passed.
+TEST(ScheduleCadence, SettledAndHeld) {
+  EXPECT_TRUE(channel_settled(23100, 25000, 25000, 2000));
+  EXPECT_FALSE(channel_settled(22900, 25000, 25000, 2000));
+  EXPECT_FALSE(channel_settled(24000, 24000, 25000, 2000)) << "setpoint still ramping";
+  const Cadence c{Cadence::Mode::settle, 0.5, 10};
+  EXPECT_FALSE(c.may_end(-1, 0.9, 1.0, true)) << "the rest phase lasts rest_s";
+  EXPECT_TRUE(c.may_end(-1, 1.0, 1.0, true));
+  EXPECT_FALSE(c.may_end(3, 0.4, 1.0, true));
+  EXPECT_TRUE(c.may_end(3, 0.5, 1.0, true));
+  EXPECT_FALSE(c.may_end(3, 2.0, 1.0, false));
+  EXPECT_FALSE(c.timed_out(-1, 100)) << "the rest phase has no timeout";
+  EXPECT_TRUE(c.timed_out(0, 10.1));
+}
+
 TEST(ScheduleQuery, StatesAndStepSetpoints) {
   Schedule s = Schedule::from_matrix(rolling_matrix(), 1.237, 2, 0, 12000);
   // Column 1 (t in [0, 1.237)): bladder 8 inflated; column 9 wraps to column 1.

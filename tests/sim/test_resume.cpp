@@ -19,6 +19,7 @@
 #include "sim/scene.h"
 #include "sim/simulation.h"
 #include "tests/support/temp_dir.h"
+#include "tests/support/tube_scene.h"
 
 using namespace morphfem;
 namespace fs = std::filesystem;
@@ -44,6 +45,23 @@ loads:
 dynamics: {scheme: bdf2, shear_viscosity: 20}
 solver: {end_time: 0.4, initial_step: 0.01, max_step: 0.05}
 output: {directory: out, every: 2, checkpoint_s: 0}
+)";
+
+// A valve-fed tube whose schedule plays in settle mode: the column starts the
+// schedule clock decided, which the loads follow, are part of the state.
+const std::string kSettleTube = "name: settle_tube\n" +
+                                quarter_tube("inner_radius: 0.005, outer_radius: 0.01, height: 0.004, mesh_size: 0.004",
+                                             "{model: dragon_skin_30}") +
+                                R"(actuation:
+  schedule: {morphfem_schedule: 1, cadence: {mode: settle, min_hold_s: 0.1},
+             matrix: ["101", "000", "000", "000", "000", "000", "000", "000", "000", "000"],
+             pressures: {feet: {inflate_pa: 0, deflate_pa: 0}}}
+  start: 0.05
+  bladders: {b1: inner}
+  volume_axes: [x, y]
+  valves: {fill_time_s: 0.05}
+solver: {end_time: 0.8, initial_step: 0.005, max_step: 0.005}
+output: {directory: out, every: 5, checkpoint_s: 0}
 )";
 
 struct SceneFile {
@@ -135,6 +153,7 @@ void expect_resume_matches(const std::string& name, const std::string& text, int
   for (size_t i = 0; i < a.cavity_pressure.size(); ++i)
     EXPECT_NEAR(a.cavity_pressure[i], b.cavity_pressure[i], 1e-10 * std::abs(a.cavity_pressure[i]));
   EXPECT_EQ(a.trajectory.size(), b.trajectory.size());
+  EXPECT_EQ(a.column_starts, b.column_starts);
 
   // The same result files: as many steps, and the same energy table row by row.
   const fs::path ha = whole.out / (name + ".h5"), hb = parts.out / (name + ".h5");
@@ -154,6 +173,15 @@ void expect_resume_matches(const std::string& name, const std::string& text, int
 TEST(Resume, SlidingBlockWithFrictionContinuesExactly) { expect_resume_matches("slide", kSlide, 7, 0); }
 
 TEST(Resume, ValveFedBalloonWithBdf2AndDampingContinuesExactly) { expect_resume_matches("balloon", kBalloon, 4, 3); }
+
+TEST(Resume, SettleCadenceContinuesWithItsColumnStarts) {
+  SceneFile probe("settle_probe", kSettleTube);
+  const auto whole = run_scene(probe.scene(), PETSC_COMM_WORLD, probe.options(false));
+  ASSERT_TRUE(whole.gait_complete) << "the gait should end within the run";
+  ASSERT_EQ(whole.column_starts.size(), 4u);
+  EXPECT_GT(whole.column_starts[1], 0.05 + 0.1) << "the first column lasts past its hold: the valve decides";
+  expect_resume_matches("settle_tube", kSettleTube, 40, 50);  // stops in the first and the second column
+}
 
 // The sliding block with at most six Newton iterations per step has its steps
 // cut: the counts by cause continue across the checkpoints as the other counters do.

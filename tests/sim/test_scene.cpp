@@ -16,6 +16,7 @@
 #include "mesh/geometry.h"
 #include "sim/scene.h"
 #include "sim/simulation.h"
+#include "tests/support/tube_scene.h"
 
 using namespace morphfem;
 namespace fs = std::filesystem;
@@ -338,16 +339,10 @@ solver: {end_time: 1, initial_step: 0.02, max_step: 0.02, formulation: mean_dila
 // rolling schedule (gait from t = 0.5 s); `extra` goes into the actuation map.
 static std::string scheduled_tube(const std::string& extra) {
   const std::string schedule = std::string(MORPHFEM_SOURCE_DIR) + "/examples/schedules/rolling.yaml";
-  return R"(geometry: {type: thick_cylinder, inner_radius: 0.005, outer_radius: 0.02, mesh_size: 0.004, order: 1}
-materials:
-  body: {model: dragon_skin_10}
-boundary:
-  - {surface: sym_x, fix: [x]}
-  - {surface: sym_y, fix: [y]}
-  - {surface: zmin, fix: [z]}
-  - {surface: zmax, fix: [z]}
-actuation: {schedule: )" +
-         schedule + ", start: 0.5, bladders: {b1: inner}, volume_axes: [x, y]" + extra + "}\n";
+  return quarter_tube("inner_radius: 0.005, outer_radius: 0.02, mesh_size: 0.004, order: 1",
+                      "{model: dragon_skin_10}") +
+         "actuation: {schedule: " + schedule + ", start: 0.5, bladders: {b1: inner}, volume_axes: [x, y]" + extra +
+         "}\n";
 }
 
 // A schedule file drives a cavity: bladder 1 of the rolling schedule (inflated in
