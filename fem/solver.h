@@ -75,9 +75,10 @@ struct SolverOptions {
   // switches): with land_on_breakpoints, steps land exactly on them too, and the steps
   // up to each stop (breakpoint or output time) are equal and no longer than the current
   // step, so a load switches at its own time whatever the step sequence. Without it,
-  // only output times are stops, and a step stretches by up to 25 % to reach one.
+  // only output times are stops, and a step stretches by up to 25 % to reach one. Off by
+  // default: the gaits' reference speeds were measured without it (docs/solver-notes.md).
   std::vector<double> breakpoints;
-  bool land_on_breakpoints = true;
+  bool land_on_breakpoints = false;
 };
 // Breakpoints closer than this fraction of dt_max to the one before share its stop.
 constexpr double kBreakpointMerge = 0.02;

@@ -41,6 +41,7 @@ struct ActuationReader {
   Scene &scene;
   const Schedule &schedule;
   const std::string key = "actuation";
+  const std::size_t first_breakpoint = scene.solver.breakpoints.size();  // the schedule's come after
   const VoxelActuation voxel;
   double start = 0.0;
   std::string timing;  // "schedule" or "voxel"
@@ -254,6 +255,9 @@ void ActuationReader::read_cadence(std::size_t first_valve, std::size_t first_fo
   for (const auto &[foot, channel] : {std::pair<const char *, int>{"foot_a", kChannelFootA}, {"foot_b", kChannelFootB}})
     if (a["feet"] && a["feet"][foot]) settle.feet.emplace_back(region++, channel);
   read_channel_map(settle);
+  // The columns start where the run decides, always at a step's end: the fixed-time
+  // schedule's breakpoints are not stops (ramp ends within a column are not either).
+  scene.solver.breakpoints.resize(first_breakpoint);
   scene.gait.end = std::numeric_limits<double>::quiet_NaN();  // decided by the run
   scene.gait.column_starts.clear();
   scene.settle = std::move(settle);

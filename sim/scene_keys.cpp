@@ -166,7 +166,7 @@ void add_solver_keys(Keys& t) {
           "Newton also converges once its step moves no node faster than this (0: off)", kNonNegative),
       key("solver.extrapolate", K::boolean, "", "true",
           "start Newton from the last step's velocity (false: from the last state)"),
-      key("solver.land_on_breakpoints", K::boolean, "", "true",
+      key("solver.land_on_breakpoints", K::boolean, "", "false",
           "steps end on the loads' breakpoints (schedule columns, ramp ends, foot switches) and are equal up to each "
           "(false: only output times are stops)"),
       choice("solver.linear_solver", "mumps", {"mumps", "mumps_lu", "gamg"},
