@@ -203,6 +203,7 @@ output: {})");
       {"environment.slope_deg", [&] { return std::atan2(std::hypot(g.x(), g.y()), -g.z()) * 180 / M_PI; }},
       {"environment.gravity", [&] { return g.norm(); }},
       {"solver.extrapolate", [&] { return quiet.solver.extrapolate; }},
+      {"solver.land_on_breakpoints", [&] { return quiet.solver.land_on_breakpoints; }},
   };
   const std::map<std::string, std::function<std::string()>> choices = {
       {"solver.linear_solver", [&] { return quiet.solver.linear_solver; }},
