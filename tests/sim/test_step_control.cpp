@@ -73,8 +73,9 @@ TEST(StepControl, StepsLandOnTheScheduleBreakpointsInEqualSteps) {
     EXPECT_LE(h, max_step * (1 + 1e-12)) << "step ending at " << times[i];
     const auto next = std::lower_bound(stops.begin(), stops.end(), times[i] - 1e-12);
     if (i + 1 < times.size() && next != stops.end() && times[i + 1] <= *next + 1e-12 &&
-        std::abs(times[i] - *next) > 1e-12)
+        std::abs(times[i] - *next) > 1e-12) {
       EXPECT_NEAR(times[i + 1] - times[i], h, 1e-12) << "unequal steps before the stop " << *next;
+    }
   }
   // The same scene without landing: the first column boundary is crossed, not hit.
   EXPECT_FALSE(has_time(step_times(false), start + column));
