@@ -597,16 +597,13 @@ bool IncrementalSolver::solve_step(double t_new, int& newton_its, int& linear_it
   return ok;
 }
 
-RunStats IncrementalSolver::run(const std::function<void(const StepReport&)>& on_step) {
-  auto start = std::chrono::steady_clock::now();
-  RunStats stats = counters_;
-  stats.completed = false;
-  stats.failure.clear();
-  for (const auto& term : assembler_.terms()) term->set_time(t_);
+// The times steps land on: output times, the end and (with land_on_breakpoints) the
+// loads' breakpoints, sorted. A breakpoint within kBreakpointMerge * dt_max of the one
+// before is not a stop of its own (the end of a switch that takes a fraction of a
+// millisecond).
+std::vector<double> IncrementalSolver::step_stops() const {
   std::vector<double> stops = opt_.output_times;
   if (opt_.land_on_breakpoints) {
-    // A breakpoint within kBreakpointMerge * dt_max of the one before is not a stop of
-    // its own (the end of a switch that takes a fraction of a millisecond).
     std::vector<double> breaks = opt_.breakpoints;
     std::sort(breaks.begin(), breaks.end());
     double last = -1e300;
@@ -618,27 +615,39 @@ RunStats IncrementalSolver::run(const std::function<void(const StepReport&)>& on
   }
   stops.push_back(opt_.t_end);
   std::sort(stops.begin(), stops.end());
+  return stops;
+}
+
+// The end of the next step of size about dt from t_, landing exactly on the next stop.
+double IncrementalSolver::step_end(const std::vector<double>& stops, double dt, double eps) const {
+  double next_stop = opt_.t_end;
+  for (double s : stops)
+    if (s > t_ + eps) {
+      next_stop = s;
+      break;
+    }
+  if (opt_.land_on_breakpoints) {
+    // n equal steps to the next stop, none longer than dt: no sliver before it.
+    const double n = std::max(1.0, std::ceil((next_stop - t_) / dt - 1e-9));
+    return n > 1 ? t_ + (next_stop - t_) / n : next_stop;
+  }
+  const double t_new = std::min(t_ + dt, next_stop);
+  // Never leave a sliver before an output time: stretch this step by up to 25 %.
+  return next_stop - t_new < 0.25 * dt ? next_stop : t_new;
+}
+
+RunStats IncrementalSolver::run(const std::function<void(const StepReport&)>& on_step) {
+  auto start = std::chrono::steady_clock::now();
+  RunStats stats = counters_;
+  stats.completed = false;
+  stats.failure.clear();
+  for (const auto& term : assembler_.terms()) term->set_time(t_);
+  const std::vector<double> stops = step_stops();
   double dt = dt_next_ > 0 ? std::min(dt_next_, opt_.dt_max) : std::min(opt_.dt_initial, opt_.dt_max);
   int cuts = 0;
   const double eps = 1e-12 * std::max(1.0, opt_.t_end);
   while (t_ < opt_.t_end - eps) {
-    // Land exactly on the next output time.
-    double next_stop = opt_.t_end;
-    for (double s : stops)
-      if (s > t_ + eps) {
-        next_stop = s;
-        break;
-      }
-    double t_new = next_stop;
-    if (opt_.land_on_breakpoints) {
-      // n equal steps to the next stop, none longer than dt: no sliver before it.
-      const double n = std::max(1.0, std::ceil((next_stop - t_) / dt - 1e-9));
-      if (n > 1) t_new = t_ + (next_stop - t_) / n;
-    } else {
-      t_new = std::min(t_ + dt, next_stop);
-      // Never leave a sliver before an output time: stretch this step by up to 25 %.
-      if (next_stop - t_new < 0.25 * dt) t_new = next_stop;
-    }
+    const double t_new = step_end(stops, dt, eps);
     int its = 0, lits = 0;
     std::string why;
     if (solve_step(t_new, its, lits, why)) {

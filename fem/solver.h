@@ -142,6 +142,8 @@ class IncrementalSolver {
   PetscErrorCode operator_mult(Vec x, Vec y);  // (H + sum c v v^T) x
 
  private:
+  std::vector<double> step_stops() const;
+  double step_end(const std::vector<double>& stops, double dt, double eps) const;
   void apply_dirichlet(Vec u, double t) const;
   void set_jacobian();    // (re)attach the Hessian (and shell operator) to SNES
   void refresh_pieces();  // lets terms rebuild state-dependent pieces (then a new pattern)
